@@ -1,0 +1,1 @@
+//! Per-shape cache: placeholder.

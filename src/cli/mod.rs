@@ -1,0 +1,43 @@
+//! Subcommands of the `coseg` binary, one file each.
+
+mod info;
+
+use clap::{Parser, Subcommand};
+use std::process::ExitCode;
+
+/// Exit code when the command failed as a whole.
+pub const EXIT_FAILURE: u8 = 1;
+/// Exit code when some input files were reported and skipped but the rest succeeded.
+pub const EXIT_PARTIAL: u8 = 3;
+
+/// coseg: stable region correspondences and co-segmentation of 3D shape collections.
+#[derive(Debug, Parser)]
+#[command(name = "coseg", version, about, long_about = None)]
+pub struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Load meshes, validate them and print their counts and warnings.
+    Info(info::InfoArgs),
+}
+
+/// Runs a parsed command line; the exit code tells success, partial success or failure.
+pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
+    match cli.command {
+        Command::Info(args) => info::run(args),
+    }
+}
+
+/// 0 when nothing failed, [`EXIT_FAILURE`] when everything failed, [`EXIT_PARTIAL`] otherwise.
+fn exit_code(failed: usize, total: usize) -> ExitCode {
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else if failed == total {
+        ExitCode::from(EXIT_FAILURE)
+    } else {
+        ExitCode::from(EXIT_PARTIAL)
+    }
+}

@@ -1,0 +1,32 @@
+//! # coseg — stable region correspondences across shape collections
+//!
+//! coseg finds corresponding parts across a collection of 3D triangle meshes (co-segmentation)
+//! and carries part labels from a few annotated shapes to the others. It implements
+//! *Stable Region Correspondences Between Non-Isometric Shapes* (Ganapathi-Subramanian, Thibert,
+//! Ovsjanikov, Guibas; SGP 2016) and extends it from pairs to collections.
+//!
+//! The pipeline, one module per stage, dependencies flowing one way:
+//!
+//! | stage | module | what it produces |
+//! |---|---|---|
+//! | meshes | [`mesh`] | validated triangle meshes, readers and writers (OBJ, OFF, PLY) |
+//! | spectrum | [`spectral`] | cotangent Laplacian, lumped mass, Laplace–Beltrami eigenpairs |
+//! | features | [`features`] | HKS, WKS and multiscale mean curvature per vertex |
+//! | bands | [`bands`] | per-feature rank bands stored as a compact `u8` table |
+//! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
+//! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
+//! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
+//! | output | [`output`] | region files, coloured meshes, summaries |
+//! | shape families | [`generate`] | synthetic collections with ground-truth parts |
+#![deny(missing_docs)]
+
+pub mod affinity;
+pub mod bands;
+pub mod cache;
+pub mod features;
+pub mod generate;
+pub mod graph;
+pub mod mesh;
+pub mod output;
+pub mod spectral;
+pub mod stable;
