@@ -78,7 +78,7 @@ fn obj_face_may_name_a_later_vertex() {
 
 #[test]
 fn off_variants_comments_and_polygons() {
-    let expected_pos = vec![
+    let expected_pos = [
         [0.0, 0.0, 0.0],
         [1.0, 0.0, 0.0],
         [1.0, 1.0, 0.0],
@@ -86,7 +86,7 @@ fn off_variants_comments_and_polygons() {
         [0.5, 0.5, 1.0],
     ];
     // Quad base fanned from its first corner, then 4 side triangles.
-    let expected_faces = vec![
+    let expected_faces = [
         [0, 3, 2],
         [0, 2, 1],
         [0, 1, 4],
@@ -193,7 +193,7 @@ fn ply_reads_every_encoding_list_type_and_index_name() {
         vec![2, 3, 4],
         vec![3, 0, 4],
     ];
-    let expected_faces = vec![
+    let expected_faces = [
         [0, 3, 2],
         [0, 2, 1],
         [0, 1, 4],
@@ -337,7 +337,7 @@ fn writers_round_trip_fixtures_bit_for_bit() {
         vec![
             [-0.0, 5e-324, 1e150],
             [1.7976931348623157e-300, 2.2250738585072014e-308, -1e-300],
-            [0.1, 1.0 / 3.0, -123456789.123456789],
+            [0.1, 1.0 / 3.0, -123_456_789.123_456_78],
             [f64::EPSILON, 1.0 + f64::EPSILON, 2.0f64.sqrt()],
         ],
         vec![[0, 1, 2], [2, 2, 1]],
@@ -487,7 +487,7 @@ fn kind(e: &MeshError) -> Option<Kind> {
 }
 
 /// Every corpus file with the error kind it must give and a fragment its message must contain.
-pub const CORPUS: &[(&str, Kind, &str)] = &[
+const CORPUS: &[(&str, Kind, &str)] = &[
     ("empty.off", Kind::Empty, "empty mesh"),
     ("blank.obj", Kind::Empty, "empty mesh"),
     ("comments_only.off", Kind::Empty, "empty mesh"),
