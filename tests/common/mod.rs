@@ -1,0 +1,4 @@
+//! Shared test fixtures, one file per area.
+#![allow(dead_code)]
+
+pub mod features;
