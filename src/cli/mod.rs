@@ -1,5 +1,6 @@
 //! Subcommands of the `coseg` binary, one file each.
 
+mod features;
 mod info;
 
 use clap::{Parser, Subcommand};
@@ -22,12 +23,15 @@ pub struct Cli {
 enum Command {
     /// Load meshes, validate them and print their counts and warnings.
     Info(info::InfoArgs),
+    /// Compute a mesh's descriptors and band table and export them (.npy or .csv).
+    Features(features::FeaturesArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Info(args) => info::run(args),
+        Command::Features(args) => features::run(args),
     }
 }
 
