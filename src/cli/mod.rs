@@ -1,5 +1,6 @@
 //! Subcommands of the `coseg` binary, one file each.
 
+mod generate;
 mod info;
 
 use clap::{Parser, Subcommand};
@@ -22,12 +23,15 @@ pub struct Cli {
 enum Command {
     /// Load meshes, validate them and print their counts and warnings.
     Info(info::InfoArgs),
+    /// Generate a synthetic shape family with ground-truth part labels.
+    Generate(generate::GenerateArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Info(args) => info::run(args),
+        Command::Generate(args) => generate::run(args),
     }
 }
 
