@@ -4,3 +4,7 @@
 pub mod mesh;
 pub mod stable;
 pub mod features;
+//! Shared test fixtures, one module per area.
+#![allow(dead_code)]
+
+pub mod generate;
