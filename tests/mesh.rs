@@ -838,3 +838,39 @@ fn shared_data_loads_with_header_counts_and_round_trips() {
     }
     eprintln!("checked {} files", files.len());
 }
+
+#[test]
+fn huge_declared_counts_fail_cleanly_without_allocating_them() {
+    let off = "OFF\n4000000000 4000000000 0\n0 0 0\n";
+    let err = read_mesh_from_bytes(off.as_bytes(), MeshFormat::Off).unwrap_err();
+    assert!(matches!(err, MeshError::Truncated { .. }), "{err:?}");
+    let off = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n";
+    let err = read_mesh_from_bytes(off.as_bytes(), MeshFormat::Off).unwrap_err();
+    assert!(matches!(err, MeshError::Parse { .. }), "{err:?}");
+    for count in ["uint", "int"] {
+        let mut ply = format!(
+            "ply\nformat binary_little_endian 1.0\nelement vertex 3000000000\nproperty double x\nproperty double y\nproperty double z\nelement face 1\nproperty list {count} int vertex_indices\nend_header\n"
+        )
+        .into_bytes();
+        ply.extend_from_slice(&[0u8; 72]);
+        let err = read_mesh_from_bytes(&ply, MeshFormat::Ply).unwrap_err();
+        assert!(matches!(err, MeshError::Truncated { .. }), "{err:?}");
+        // A face list declaring 4 294 967 295 (or -1) entries.
+        let mut ply = format!(
+            "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\nelement face 1\nproperty list {count} int vertex_indices\nend_header\n"
+        )
+        .into_bytes();
+        for p in [[0.0f64, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            for c in p {
+                ply.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        ply.extend_from_slice(&u32::MAX.to_le_bytes());
+        ply.extend_from_slice(&[0u8; 12]);
+        let err = read_mesh_from_bytes(&ply, MeshFormat::Ply).unwrap_err();
+        assert!(
+            matches!(err, MeshError::Truncated { .. } | MeshError::Parse { .. }),
+            "{err:?}"
+        );
+    }
+}
