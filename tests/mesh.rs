@@ -758,8 +758,9 @@ proptest! {
         which in 0usize..5,
         edits in proptest::collection::vec(edit(), 1..6),
     ) {
-        let samples = valid_samples();
-        let (fmt, mut bytes) = samples[which].clone();
+        static SAMPLES: std::sync::OnceLock<Vec<(MeshFormat, Vec<u8>)>> =
+            std::sync::OnceLock::new();
+        let (fmt, mut bytes) = SAMPLES.get_or_init(valid_samples)[which].clone();
         apply(&mut bytes, &edits);
         // Any format's parser on any mutated file: none may panic.
         let _ = read_mesh_from_bytes(&bytes, fmt);
