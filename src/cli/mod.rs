@@ -1,6 +1,7 @@
 //! Subcommands of the `coseg` binary, one file each.
 
 mod info;
+mod spectrum;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -22,12 +23,15 @@ pub struct Cli {
 enum Command {
     /// Load meshes, validate them and print their counts and warnings.
     Info(info::InfoArgs),
+    /// Print the k smallest Laplace–Beltrami eigenvalues of a mesh scaled to unit area.
+    Spectrum(spectrum::SpectrumArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Info(args) => info::run(args),
+        Command::Spectrum(args) => spectrum::run(args),
     }
 }
 

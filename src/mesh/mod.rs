@@ -14,8 +14,8 @@ pub mod io;
 mod topology;
 mod validate;
 
-pub use io::{read_mesh, read_mesh_with_report, write_mesh, MeshFormat, PlyVertexProperty};
-pub use topology::{boundary_edges, connected_components, edges, Components};
+pub use io::{MeshFormat, PlyVertexProperty, read_mesh, read_mesh_with_report, write_mesh};
+pub use topology::{Components, boundary_edges, connected_components, edges};
 pub use validate::{MeshReport, MeshWarning};
 
 /// Errors raised while reading, writing or building a mesh. Every variant that concerns a file
