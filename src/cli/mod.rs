@@ -1,5 +1,6 @@
 //! Subcommands of the `coseg` binary, one file each.
 
+mod convert;
 mod info;
 mod spectrum;
 
@@ -25,6 +26,8 @@ enum Command {
     Info(info::InfoArgs),
     /// Print the k smallest Laplace–Beltrami eigenvalues of a mesh scaled to unit area.
     Spectrum(spectrum::SpectrumArgs),
+    /// Convert a mesh between OBJ, OFF and PLY (format by extension), keeping vertex order.
+    Convert(convert::ConvertArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
@@ -32,6 +35,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Info(args) => info::run(args),
         Command::Spectrum(args) => spectrum::run(args),
+        Command::Convert(args) => convert::run(args),
     }
 }
 
