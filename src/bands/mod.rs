@@ -12,9 +12,7 @@ pub enum BandError {
     #[error("band count K = {0} must be in 1..=256")]
     BadBandCount(usize),
     /// The feature array does not have `features × vertices` entries.
-    #[error(
-        "expected {expected} feature values ({features} features × {vertices} vertices), got {got}"
-    )]
+    #[error("expected {expected} feature values ({features} features × {vertices} vertices), got {got}")]
     ShapeMismatch {
         /// Features.
         features: usize,
@@ -100,10 +98,7 @@ pub fn equal_count_bands(
     for k in 0..features {
         let f = &values[k * vertices..(k + 1) * vertices];
         if let Some(v) = f.iter().position(|x| x.is_nan()) {
-            return Err(BandError::NaN {
-                feature: k,
-                vertex: v,
-            });
+            return Err(BandError::NaN { feature: k, vertex: v });
         }
         order.clear();
         order.extend(0..vertices as u32);
