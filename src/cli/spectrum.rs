@@ -27,6 +27,12 @@ pub struct SpectrumArgs {
     /// Seed of the Lanczos start block.
     #[arg(long, default_value_t = 0)]
     seed: u64,
+    /// Threads for the solver (0 = all available, 1 = sequential).
+    #[arg(long, default_value_t = SpectrumOptions::default().threads)]
+    threads: usize,
+    /// Maximum Krylov basis size (default: about twice the eigenpairs computed).
+    #[arg(long)]
+    basis_size: Option<usize>,
     /// Print solver statistics (timings, factor size) to stderr.
     #[arg(long)]
     stats: bool,
@@ -40,6 +46,8 @@ pub fn run(args: SpectrumArgs) -> Result<ExitCode> {
         tolerance: args.tolerance,
         block_size: args.block_size,
         seed: args.seed,
+        threads: args.threads,
+        basis_size: args.basis_size,
         ..SpectrumOptions::default()
     };
     let (spectrum, stats) = laplace_beltrami_spectrum_with_stats(&mesh, &options)
