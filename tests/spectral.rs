@@ -349,3 +349,34 @@ fn bad_requests_are_typed_errors() {
     ));
     let _ = grid_parts(1, 1, 1.0, 1.0);
 }
+
+/// Real COSEG chair meshes: the number of exact zero eigenvalues equals the number of
+/// components of `L`'s graph, the spectrum is sorted and residuals are tiny. Skips when the
+/// evaluation data is absent.
+#[test]
+fn coseg_chairs_if_data_present() {
+    let dir = std::path::Path::new("/work/shared/data/coseg_chairs/shapes");
+    if !dir.exists() {
+        eprintln!("skipping: {} absent", dir.display());
+        return;
+    }
+    let mut checked = 0;
+    for name in ["0.off", "1.off", "101.off"] {
+        let Ok(mesh) = coseg::mesh::read_mesh(dir.join(name)) else {
+            continue;
+        };
+        let opts = SpectrumOptions {
+            dense_below: 0,
+            ..SpectrumOptions::with_eigenpairs(30)
+        };
+        let (s, stats) = coseg::spectral::laplace_beltrami_spectrum_with_stats(&mesh, &opts)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let zeros = s.eigenvalues.iter().filter(|&&x| x == 0.0).count();
+        assert_eq!(zeros, stats.components.min(30), "{name}");
+        assert!(s.eigenvalues.windows(2).all(|w| w[0] <= w[1]));
+        let res = euclidean_residual(&mesh, &s);
+        assert!(res < 1e-8, "{name}: residual {res}");
+        checked += 1;
+    }
+    assert!(checked > 0);
+}

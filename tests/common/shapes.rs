@@ -4,6 +4,9 @@
 use coseg::mesh::TriMesh;
 use std::collections::HashMap;
 
+/// A mesh as plain parts: positions and triangles.
+pub type Parts = (Vec<[f64; 3]>, Vec<[u32; 3]>);
+
 /// Vertices and faces of an icosphere: a regular icosahedron subdivided `subdivisions` times
 /// (each triangle into four), every vertex projected onto the sphere of radius `radius`
 /// centred at the origin. `10·4^s + 2` vertices, `20·4^s` faces, counter-clockwise (outward).
@@ -117,9 +120,9 @@ pub fn grid(nx: usize, ny: usize, w: f64, h: f64) -> TriMesh {
 
 /// Concatenates meshes given as parts, translating part `i` by `offsets[i]`.
 pub fn union_parts(
-    parts: &[(Vec<[f64; 3]>, Vec<[u32; 3]>)],
+    parts: &[Parts],
     offsets: &[[f64; 3]],
-) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+) -> Parts {
     let mut pos = Vec::new();
     let mut faces = Vec::new();
     for ((p, f), o) in parts.iter().zip(offsets) {
