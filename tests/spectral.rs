@@ -1,4 +1,5 @@
 //! Tests of the spectral stage: cotangent Laplacian, lumped mass, sparse eigensolver.
+#![allow(clippy::needless_range_loop)] // index-heavy numerical checks read better with indices
 
 mod common;
 
