@@ -119,10 +119,7 @@ pub fn grid(nx: usize, ny: usize, w: f64, h: f64) -> TriMesh {
 }
 
 /// Concatenates meshes given as parts, translating part `i` by `offsets[i]`.
-pub fn union_parts(
-    parts: &[Parts],
-    offsets: &[[f64; 3]],
-) -> Parts {
+pub fn union_parts(parts: &[Parts], offsets: &[[f64; 3]]) -> Parts {
     let mut pos = Vec::new();
     let mut faces = Vec::new();
     for ((p, f), o) in parts.iter().zip(offsets) {
