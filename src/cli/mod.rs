@@ -4,6 +4,7 @@ mod convert;
 mod features;
 mod generate;
 mod info;
+mod spectrum;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -25,6 +26,8 @@ pub struct Cli {
 enum Command {
     /// Load meshes, validate them and print their counts and warnings.
     Info(info::InfoArgs),
+    /// Print the k smallest Laplace–Beltrami eigenvalues of a mesh scaled to unit area.
+    Spectrum(spectrum::SpectrumArgs),
     /// Convert a mesh between OBJ, OFF and PLY (format by extension), keeping vertex order.
     Convert(convert::ConvertArgs),
     /// Compute a mesh's descriptors and band table and export them (.npy or .csv).
@@ -37,6 +40,7 @@ enum Command {
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Info(args) => info::run(args),
+        Command::Spectrum(args) => spectrum::run(args),
         Command::Convert(args) => convert::run(args),
         Command::Features(args) => features::run(args),
         Command::Generate(args) => generate::run(args),

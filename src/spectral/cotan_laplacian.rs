@@ -2,8 +2,10 @@ use crate::mesh::{TriMesh, cross, dot, norm, sub};
 use faer::sparse::{SparseColMat, Triplet};
 
 /// Largest magnitude allowed for a cotangent weight. Nearly degenerate triangles have
-/// unbounded cotangents; clamping keeps `L` well conditioned at the price of a local error on
-/// those triangles only. Degenerate (zero-area) triangles contribute nothing.
+/// unbounded cotangents; when one of a triangle's cotangents exceeds this, all three are scaled
+/// down by the same factor (which keeps `L` positive semi-definite), bounding `L`'s entries at
+/// the price of a local error on those triangles only. Degenerate (zero-area) triangles
+/// contribute nothing.
 pub const MAX_COTANGENT: f64 = 1e5;
 
 /// Cotangent Laplacian `L` (`d × d`, symmetric positive semi-definite, weak form):
@@ -22,17 +24,36 @@ pub fn cotan_laplacian(mesh: &TriMesh) -> SparseColMat<usize, f64> {
     for f in 0..mesh.face_count() {
         let idx = mesh.faces()[f];
         let p = mesh.corners(f);
-        for k in 0..3 {
-            // Angle at corner k, opposite edge (k+1, k+2).
-            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-            let u = sub(p[i], p[k]);
-            let v = sub(p[j], p[k]);
+        // Cotangent of the angle at each corner k, opposite edge (k+1, k+2).
+        let mut cot = [0.0f64; 3];
+        let mut degenerate = false;
+        for (k, ck) in cot.iter_mut().enumerate() {
+            let u = sub(p[(k + 1) % 3], p[k]);
+            let v = sub(p[(k + 2) % 3], p[k]);
             let c = norm(cross(u, v));
-            if !(c > 0.0) {
-                continue;
+            if c.is_nan() || c <= 0.0 || !c.is_finite() {
+                degenerate = true;
+                break;
             }
-            let cot = (dot(u, v) / c).clamp(-MAX_COTANGENT, MAX_COTANGENT);
-            let w = 0.5 * cot;
+            *ck = dot(u, v) / c;
+        }
+        if degenerate {
+            continue;
+        }
+        // Clamp by scaling all three cotangents of the triangle by the same factor: this keeps
+        // the triangle's stiffness matrix positive semi-definite (its cotangents satisfy
+        // c₀c₁ + c₁c₂ + c₂c₀ = 1 > 0, which a common positive factor preserves), whereas
+        // clamping each one separately can make a needle triangle indefinite.
+        let big = cot.iter().fold(0.0f64, |a, c| a.max(c.abs()));
+        if big > MAX_COTANGENT {
+            let s = MAX_COTANGENT / big;
+            for c in cot.iter_mut() {
+                *c *= s;
+            }
+        }
+        for (k, &ck) in cot.iter().enumerate() {
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            let w = 0.5 * ck;
             let (a, b) = (idx[i] as usize, idx[j] as usize);
             triplets.push(Triplet::new(a, b, -w));
             triplets.push(Triplet::new(b, a, -w));

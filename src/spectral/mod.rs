@@ -5,12 +5,18 @@
 //! eigenvalues, diffusion times and energies mean the same on every shape of a collection,
 //! whatever the units of its file. Eigenvectors are M-orthonormal for the unit-area mass.
 
+mod block_lanczos;
 mod cotan_laplacian;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
+mod shift_invert;
 
 pub use cotan_laplacian::cotan_laplacian;
 pub use laplace_beltrami_spectrum::{SpectrumOptions, dense_spectrum, laplace_beltrami_spectrum};
+pub use laplace_beltrami_spectrum::{
+    SpectrumOptions, SpectrumStats, dense_spectrum, laplace_beltrami_spectrum,
+    laplace_beltrami_spectrum_with_stats,
+};
 pub use lumped_mass::lumped_mass;
 
 use thiserror::Error;
@@ -26,6 +32,9 @@ pub enum SpectralError {
         /// Number of vertices.
         vertices: usize,
     },
+    /// An option is out of its valid range.
+    #[error("invalid spectrum option: {0}")]
+    InvalidOption(String),
     /// A factorisation or eigensolver failed.
     #[error("eigensolver failed: {0}")]
     Solver(String),

@@ -5,3 +5,4 @@ pub mod features;
 pub mod generate;
 pub mod mesh;
 pub mod stable;
+pub mod shapes;

@@ -1,0 +1,383 @@
+//! Tests of the spectral stage: cotangent Laplacian, lumped mass, sparse eigensolver.
+#![allow(clippy::needless_range_loop)] // index-heavy numerical checks read better with indices
+
+mod common;
+
+use common::shapes::{grid, grid_parts, icosphere, icosphere_parts, jitter, union_parts};
+use coseg::mesh::TriMesh;
+use coseg::spectral::{
+    SpectralError, Spectrum, SpectrumOptions, cotan_laplacian, dense_spectrum,
+    laplace_beltrami_spectrum, lumped_mass,
+};
+use std::f64::consts::PI;
+
+/// Options forcing the sparse path even on small meshes.
+fn sparse_opts(k: usize) -> SpectrumOptions {
+    SpectrumOptions {
+        dense_below: 0,
+        ..SpectrumOptions::with_eigenpairs(k)
+    }
+}
+
+/// `y = L x` for the mesh's cotangent Laplacian.
+fn l_times(mesh: &TriMesh, x: &[f64]) -> Vec<f64> {
+    let l = cotan_laplacian(mesh);
+    let l = l.as_ref();
+    let mut y = vec![0.0; x.len()];
+    for j in 0..x.len() {
+        for (&i, &v) in l.row_idx_of_col_raw(j).iter().zip(l.val_of_col(j)) {
+            y[i] += v * x[j];
+        }
+    }
+    y
+}
+
+/// Max over pairs of ‖Lφ − λMφ‖_{M⁻¹} / (1 + λ), and max |ΦᵀMΦ − I|.
+fn residuals(mesh: &TriMesh, s: &Spectrum) -> (f64, f64) {
+    let d = s.vertex_count();
+    let m = &s.vertex_areas;
+    let mut worst_res = 0.0f64;
+    for i in 0..s.len() {
+        let phi = s.eigenvector(i);
+        let lphi = l_times(mesh, phi);
+        let lam = s.eigenvalues[i];
+        let mut r2 = 0.0;
+        for v in 0..d {
+            if m[v] > 0.0 {
+                let r = lphi[v] - lam * m[v] * phi[v];
+                r2 += r * r / m[v];
+            }
+        }
+        worst_res = worst_res.max(r2.sqrt() / (1.0 + lam));
+    }
+    let mut worst_orth = 0.0f64;
+    for i in 0..s.len() {
+        for j in 0..=i {
+            let g: f64 = (0..d)
+                .map(|v| m[v] * s.eigenvector(i)[v] * s.eigenvector(j)[v])
+                .sum();
+            let want = if i == j { 1.0 } else { 0.0 };
+            worst_orth = worst_orth.max((g - want).abs());
+        }
+    }
+    (worst_res, worst_orth)
+}
+
+/// Max over pairs of ‖Lφ − λMφ‖₂ / (‖Lφ‖₂ + λ‖Mφ‖₂ + ‖Mφ‖₂).
+fn euclidean_residual(mesh: &TriMesh, s: &Spectrum) -> f64 {
+    let m = &s.vertex_areas;
+    let mut worst = 0.0f64;
+    for i in 0..s.len() {
+        let phi = s.eigenvector(i);
+        let lphi = l_times(mesh, phi);
+        let lam = s.eigenvalues[i];
+        let (mut r2, mut l2, mut m2) = (0.0, 0.0, 0.0);
+        for v in 0..phi.len() {
+            let mp = m[v] * phi[v];
+            r2 += (lphi[v] - lam * mp).powi(2);
+            l2 += lphi[v] * lphi[v];
+            m2 += mp * mp;
+        }
+        worst = worst.max(r2.sqrt() / (l2.sqrt() + (1.0 + lam) * m2.sqrt()));
+    }
+    worst
+}
+
+/// Largest principal-angle sine between span(a[..k]) and span(b[..k]) in the M inner product:
+/// ‖Φ_b − Φ_a (Φ_aᵀ M Φ_b)‖_M per column, maximised.
+fn subspace_distance(a: &Spectrum, b: &Spectrum, k: usize) -> f64 {
+    let d = a.vertex_count();
+    let m = &a.vertex_areas;
+    let mut worst = 0.0f64;
+    for j in 0..k {
+        let y = b.eigenvector(j);
+        let mut r = y.to_vec();
+        for i in 0..k {
+            let x = a.eigenvector(i);
+            let c: f64 = (0..d).map(|v| m[v] * x[v] * y[v]).sum();
+            for v in 0..d {
+                r[v] -= c * x[v];
+            }
+        }
+        let n2: f64 = (0..d).map(|v| m[v] * r[v] * r[v]).sum();
+        worst = worst.max(n2.sqrt());
+    }
+    worst
+}
+
+#[test]
+fn laplacian_kills_constants_is_symmetric_and_mass_sums_to_area() {
+    let (mut p, f) = icosphere_parts(2, 1.3);
+    jitter(&mut p, 0.02, 7);
+    let mesh = TriMesh::new(p, f).unwrap();
+    let d = mesh.vertex_count();
+    let l1 = l_times(&mesh, &vec![1.0; d]);
+    assert!(l1.iter().all(|x| x.abs() < 1e-12), "L·1 != 0");
+    let l = cotan_laplacian(&mesh);
+    let dense = l.as_ref().to_dense();
+    for i in 0..d {
+        for j in 0..d {
+            assert_eq!(dense[(i, j)], dense[(j, i)], "L not symmetric at ({i},{j})");
+        }
+    }
+    // PSD: xᵀLx ≥ 0 on a few deterministic vectors.
+    for s in 0..5 {
+        let x: Vec<f64> = (0..d)
+            .map(|v| ((v * 31 + s * 17) % 13) as f64 - 6.0)
+            .collect();
+        let lx = l_times(&mesh, &x);
+        let q: f64 = x.iter().zip(&lx).map(|(a, b)| a * b).sum();
+        assert!(q >= -1e-10);
+    }
+    let m: f64 = lumped_mass(&mesh).iter().sum();
+    assert!((m - mesh.total_area()).abs() < 1e-12 * m);
+    // The Dirichlet energy of a linear function on a flat grid equals |∇f|² · area.
+    let g = grid(6, 4, 3.0, 2.0);
+    let x: Vec<f64> = g.positions().iter().map(|p| 2.0 * p[0] - p[1]).collect();
+    let lx = l_times(&g, &x);
+    let e: f64 = x.iter().zip(&lx).map(|(a, b)| a * b).sum();
+    assert!((e - 5.0 * 6.0).abs() < 1e-10, "energy {e}");
+}
+
+#[test]
+fn sparse_agrees_with_dense_on_a_jittered_sphere() {
+    let (mut p, f) = icosphere_parts(3, 1.0);
+    jitter(&mut p, 0.01, 3);
+    let mesh = TriMesh::new(p, f).unwrap();
+    let k = 60;
+    let sparse = laplace_beltrami_spectrum(&mesh, &sparse_opts(k)).unwrap();
+    let dense = dense_spectrum(&mesh, k + 1).unwrap();
+    assert_eq!(sparse.len(), k);
+    assert_eq!(sparse.eigenvalues[0], 0.0);
+    for i in 1..k {
+        let (a, b) = (sparse.eigenvalues[i], dense.eigenvalues[i]);
+        assert!(
+            (a - b).abs() < 1e-9 * b,
+            "eigenvalue {i}: sparse {a}, dense {b}"
+        );
+    }
+    // Eigenspaces: cut where the dense spectrum has a gap.
+    let cut = (40..k)
+        .max_by(|&i, &j| {
+            let gi = dense.eigenvalues[i] - dense.eigenvalues[i - 1];
+            let gj = dense.eigenvalues[j] - dense.eigenvalues[j - 1];
+            gi.partial_cmp(&gj).unwrap()
+        })
+        .unwrap();
+    let dist = subspace_distance(&dense, &sparse, cut);
+    assert!(dist < 1e-6, "subspace distance {dist}");
+    let (res, orth) = residuals(&mesh, &sparse);
+    assert!(res < 1e-8, "residual {res}");
+    assert!(orth < 1e-10, "orthonormality {orth}");
+}
+
+#[test]
+fn icosphere_has_spherical_harmonic_clusters_and_skips_nothing() {
+    // 2562 vertices; a unit-area sphere has λ = l(l+1)·4π with multiplicity 2l+1.
+    let mesh = icosphere(4, 1.0);
+    let lmax = 9;
+    let k = (lmax + 1) * (lmax + 1);
+    for block in [8, 1] {
+        let opts = SpectrumOptions {
+            block_size: block,
+            ..SpectrumOptions::with_eigenpairs(k)
+        };
+        let s = laplace_beltrami_spectrum(&mesh, &opts).unwrap();
+        assert_eq!(s.eigenvalues[0], 0.0);
+        let exact = |l: usize| (l * (l + 1)) as f64 * 4.0 * PI;
+        for l in 1..=lmax {
+            // Cluster l lies between the midpoints to its neighbours' exact values.
+            let lo = 0.5 * (exact(l - 1) + exact(l));
+            let hi = 0.5 * (exact(l) + exact(l + 1));
+            let count = s.eigenvalues.iter().filter(|&&x| x > lo && x < hi).count();
+            assert_eq!(
+                count,
+                2 * l + 1,
+                "block {block}, cluster l = {l}: {:?}",
+                s.eigenvalues
+            );
+            for i in l * l..(l + 1) * (l + 1) {
+                let rel = (s.eigenvalues[i] - exact(l)).abs() / exact(l);
+                assert!(rel < 0.05, "l = {l}: {} vs {}", s.eigenvalues[i], exact(l));
+            }
+        }
+        let (res, orth) = residuals(&mesh, &s);
+        assert!(res < 1e-8 && orth < 1e-10, "block {block}: {res} {orth}");
+    }
+}
+
+#[test]
+fn icosphere_eigenvalues_converge_under_refinement() {
+    let mut previous = f64::INFINITY;
+    for sub in [2, 3, 4] {
+        let s = laplace_beltrami_spectrum(&icosphere(sub, 2.0), &sparse_opts(36)).unwrap();
+        let mut worst = 0.0f64;
+        for l in 1..6usize {
+            let exact = (l * (l + 1)) as f64 * 4.0 * PI;
+            for i in l * l..(l + 1) * (l + 1) {
+                worst = worst.max((s.eigenvalues[i] - exact).abs() / exact);
+            }
+        }
+        assert!(
+            worst < previous / 3.0,
+            "subdivision {sub}: error {worst}, before {previous}"
+        );
+        previous = worst;
+    }
+    assert!(previous < 0.02);
+}
+
+#[test]
+fn two_components_give_two_zero_eigenvalues() {
+    let a = icosphere_parts(3, 1.0);
+    let b = icosphere_parts(2, 0.5);
+    let (p, f) = union_parts(&[a, b], &[[0.0; 3], [5.0, 0.0, 0.0]]);
+    let mesh = TriMesh::new(p, f).unwrap();
+    let s = laplace_beltrami_spectrum(&mesh, &sparse_opts(30)).unwrap();
+    assert_eq!(&s.eigenvalues[..2], &[0.0, 0.0]);
+    assert!(s.eigenvalues[2] > 1.0);
+    // The zero eigenvectors are constant on each component.
+    for i in 0..2 {
+        let phi = s.eigenvector(i);
+        let first = phi[0];
+        assert!(phi[..642].iter().all(|&x| (x - first).abs() < 1e-14));
+    }
+    let dense = dense_spectrum(&mesh, 30).unwrap();
+    for i in 2..30 {
+        let (x, y) = (s.eigenvalues[i], dense.eigenvalues[i]);
+        assert!((x - y).abs() < 1e-9 * y, "{i}: {x} vs {y}");
+    }
+    let (res, orth) = residuals(&mesh, &s);
+    assert!(res < 1e-8 && orth < 1e-10);
+}
+
+#[test]
+fn unit_square_with_boundary_matches_neumann_eigenvalues() {
+    // Neumann eigenvalues of the unit square: π²(a² + b²).
+    let mesh = grid(40, 40, 1.0, 1.0);
+    let s = laplace_beltrami_spectrum(&mesh, &sparse_opts(10)).unwrap();
+    let mut exact: Vec<f64> = (0..5)
+        .flat_map(|a| (0..5).map(move |b| PI * PI * (a * a + b * b) as f64))
+        .collect();
+    exact.sort_by(|a, b| a.partial_cmp(b).unwrap());
+    for i in 1..10 {
+        let rel = (s.eigenvalues[i] - exact[i]).abs() / exact[i];
+        assert!(rel < 0.01, "{i}: {} vs {}", s.eigenvalues[i], exact[i]);
+    }
+    // Scale invariance: a 3× larger square has the same unit-area spectrum.
+    let big = grid(40, 40, 3.0, 3.0);
+    let t = laplace_beltrami_spectrum(&big, &sparse_opts(10)).unwrap();
+    for i in 1..10 {
+        assert!((t.eigenvalues[i] - s.eigenvalues[i]).abs() < 1e-8 * s.eigenvalues[i]);
+    }
+}
+
+#[test]
+fn degenerate_triangles_unreferenced_vertices_and_nonmanifold_edges_are_survived() {
+    let (mut p, mut f) = icosphere_parts(3, 1.0);
+    jitter(&mut p, 0.005, 11);
+    let n0 = p.len() as u32;
+    // A zero-area triangle on existing vertices (repeated vertex) and a collinear one.
+    f.push([0, 0, 1]);
+    p.push([2.0, 0.0, 0.0]);
+    p.push([3.0, 0.0, 0.0]);
+    p.push([4.0, 0.0, 0.0]);
+    f.push([n0, n0 + 1, n0 + 2]);
+    // A needle (cap) triangle attached to the sphere.
+    f.push([1, 2, n0 + 3]);
+    p.push([
+        0.5 * (p[1][0] + p[2][0]),
+        0.5 * (p[1][1] + p[2][1]) + 1e-9,
+        0.5 * (p[1][2] + p[2][2]),
+    ]);
+    // A fin sharing edge (3, 4): a non-manifold edge.
+    p.push([p[3][0] + 0.3, p[3][1] + 0.3, p[3][2] + 0.3]);
+    f.push([3, 4, n0 + 4]);
+    // An unreferenced vertex.
+    p.push([9.0, 9.0, 9.0]);
+    let mesh = TriMesh::new(p, f).unwrap();
+    let d = mesh.vertex_count();
+    let s = laplace_beltrami_spectrum(&mesh, &sparse_opts(20)).unwrap();
+    assert_eq!(s.eigenvalues[0], 0.0);
+    assert!(s.eigenvalues.iter().all(|x| x.is_finite() && *x >= 0.0));
+    assert!(s.eigenvalues[1] > 0.0);
+    for i in 0..20 {
+        let phi = s.eigenvector(i);
+        assert!(phi.iter().all(|x| x.is_finite()));
+        // Zero-mass vertices (collinear triangle, unreferenced) get 0.
+        assert_eq!(phi[d - 1], 0.0);
+        assert_eq!(phi[n0 as usize], 0.0);
+    }
+    // The needle vertex has a tiny mass, so the M⁻¹-weighted residual is dominated by it;
+    // measure the relative Euclidean residual instead.
+    let res = euclidean_residual(&mesh, &s);
+    let (_, orth) = residuals(&mesh, &s);
+    assert!(res < 1e-8, "residual {res}");
+    assert!(orth < 1e-9, "orthonormality {orth}");
+}
+
+#[test]
+fn output_is_deterministic_and_small_meshes_use_the_dense_path() {
+    let (mut p, f) = icosphere_parts(3, 1.0);
+    jitter(&mut p, 0.01, 5);
+    let mesh = TriMesh::new(p, f).unwrap();
+    let a = laplace_beltrami_spectrum(&mesh, &sparse_opts(25)).unwrap();
+    let b = laplace_beltrami_spectrum(&mesh, &sparse_opts(25)).unwrap();
+    assert_eq!(a, b);
+    // Default options on a 642-vertex mesh with k = 600 go dense and still agree.
+    let c = laplace_beltrami_spectrum(&mesh, &SpectrumOptions::with_eigenpairs(600)).unwrap();
+    for i in 1..25 {
+        assert!((c.eigenvalues[i] - a.eigenvalues[i]).abs() < 1e-9 * a.eigenvalues[i]);
+    }
+    let (res, orth) = residuals(&mesh, &c);
+    assert!(res < 1e-8 && orth < 1e-9);
+}
+
+#[test]
+fn bad_requests_are_typed_errors() {
+    let mesh = grid(2, 2, 1.0, 1.0);
+    assert!(matches!(
+        laplace_beltrami_spectrum(&mesh, &SpectrumOptions::with_eigenpairs(10)),
+        Err(SpectralError::TooManyEigenpairs { .. })
+    ));
+    let opts = SpectrumOptions {
+        shift: 0.5,
+        ..SpectrumOptions::with_eigenpairs(3)
+    };
+    assert!(matches!(
+        laplace_beltrami_spectrum(&mesh, &opts),
+        Err(SpectralError::InvalidOption(_))
+    ));
+    let _ = grid_parts(1, 1, 1.0, 1.0);
+}
+
+/// Real COSEG chair meshes: the number of exact zero eigenvalues equals the number of
+/// components of `L`'s graph, the spectrum is sorted and residuals are tiny. Skips when the
+/// evaluation data is absent.
+#[test]
+fn coseg_chairs_if_data_present() {
+    let dir = std::path::Path::new("/work/shared/data/coseg_chairs/shapes");
+    if !dir.exists() {
+        eprintln!("skipping: {} absent", dir.display());
+        return;
+    }
+    let mut checked = 0;
+    for name in ["0.off", "1.off", "101.off"] {
+        let Ok(mesh) = coseg::mesh::read_mesh(dir.join(name)) else {
+            continue;
+        };
+        let opts = SpectrumOptions {
+            dense_below: 0,
+            ..SpectrumOptions::with_eigenpairs(30)
+        };
+        let (s, stats) = coseg::spectral::laplace_beltrami_spectrum_with_stats(&mesh, &opts)
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let zeros = s.eigenvalues.iter().filter(|&&x| x == 0.0).count();
+        assert_eq!(zeros, stats.components.min(30), "{name}");
+        assert!(s.eigenvalues.windows(2).all(|w| w[0] <= w[1]));
+        let res = euclidean_residual(&mesh, &s);
+        assert!(res < 1e-8, "{name}: residual {res}");
+        checked += 1;
+    }
+    assert!(checked > 0);
+}
