@@ -24,7 +24,7 @@
 
 use crate::bands::{BandError, BandOptions, BandTable, band_table};
 use crate::features::{DescriptorOptions, Descriptors, FeatureError, descriptors};
-use crate::mesh::{write_atomic, TriMesh};
+use crate::mesh::{TriMesh, write_atomic};
 use crate::spectral::{SpectralError, Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
 use std::io::Write;
 use std::path::{Path, PathBuf};

@@ -3,9 +3,9 @@ use super::multiscale_mean_curvature::curvature_coefficients;
 use super::spectral_product::spectral_product;
 use super::wave_kernel_signature::wks_coefficients;
 use super::{FeatureError, SpectralBand, scale_grid};
-use faer::Mat;
 use crate::mesh::TriMesh;
 use crate::spectral::Spectrum;
+use faer::Mat;
 
 /// Options of [`descriptors`]. Every field changes the result (and so belongs in a cache key).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -72,44 +72,6 @@ pub(crate) fn cotan_laplacian_times_positions(mesh: &TriMesh) -> Vec<[f64; 3]> {
     lx
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn face_assembly_equals_the_sparse_laplacian() {
-        let mesh = TriMesh::new(
-            vec![
-                [0.0, 0.0, 0.1],
-                [1.0, 0.0, 0.0],
-                [1.2, 1.0, 0.3],
-                [0.0, 1.0, -0.2],
-                [0.5, 0.4, 0.9],
-            ],
-            vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
-        )
-        .unwrap();
-        let lx = cotan_laplacian_times_positions(&mesh);
-        let l = cotan_laplacian(&mesh);
-        for (j, x) in mesh.positions().iter().enumerate() {
-            let rows = l.as_ref().row_idx_of_col_raw(j);
-            let vals = l.as_ref().val_of_col(j);
-            let _ = x;
-            let mut want = [0.0; 3];
-            for (&i, &w) in rows.iter().zip(vals) {
-                for c in 0..3 {
-                    want[c] += w * mesh.positions()[i][c];
-                }
-            }
-            for c in 0..3 {
-                assert!((lx[j][c] - want[c]).abs() < 1e-12, "{j} {c}");
-            }
-        }
-        let total: f64 = mixed_voronoi_areas(&mesh).iter().sum();
-        assert!((total - mesh.total_area()).abs() < 1e-12);
-    }
-}
-
 /// Mixed Voronoi vertex areas (Meyer, Desbrun, Schröder, Barr 2003): the Voronoi area inside
 /// non-obtuse triangles, half/quarter of the triangle area at/beside an obtuse angle. Sums to the
 /// total area.
@@ -151,4 +113,41 @@ fn mixed_voronoi_areas(mesh: &TriMesh) -> Vec<f64> {
         }
     }
     a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_assembly_equals_the_sparse_laplacian() {
+        let mesh = TriMesh::new(
+            vec![
+                [0.0, 0.0, 0.1],
+                [1.0, 0.0, 0.0],
+                [1.2, 1.0, 0.3],
+                [0.0, 1.0, -0.2],
+                [0.5, 0.4, 0.9],
+            ],
+            vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
+        )
+        .unwrap();
+        let lx = cotan_laplacian_times_positions(&mesh);
+        let l = cotan_laplacian(&mesh);
+        for (j, got) in lx.iter().enumerate() {
+            let rows = l.as_ref().row_idx_of_col_raw(j);
+            let vals = l.as_ref().val_of_col(j);
+            let mut want = [0.0; 3];
+            for (&i, &w) in rows.iter().zip(vals) {
+                for (c, out) in want.iter_mut().enumerate() {
+                    *out += w * mesh.positions()[i][c];
+                }
+            }
+            for c in 0..3 {
+                assert!((got[c] - want[c]).abs() < 1e-12, "{j} {c}");
+            }
+        }
+        let total: f64 = mixed_voronoi_areas(&mesh).iter().sum();
+        assert!((total - mesh.total_area()).abs() < 1e-12);
+    }
 }
