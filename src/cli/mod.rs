@@ -2,6 +2,7 @@
 
 mod convert;
 mod features;
+mod generate;
 mod info;
 
 use clap::{Parser, Subcommand};
@@ -28,6 +29,8 @@ enum Command {
     Convert(convert::ConvertArgs),
     /// Compute a mesh's descriptors and band table and export them (.npy or .csv).
     Features(features::FeaturesArgs),
+    /// Generate a synthetic shape family with ground-truth part labels.
+    Generate(generate::GenerateArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
@@ -36,6 +39,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Info(args) => info::run(args),
         Command::Convert(args) => convert::run(args),
         Command::Features(args) => features::run(args),
+        Command::Generate(args) => generate::run(args),
     }
 }
 

@@ -2,4 +2,6 @@
 #![allow(dead_code)]
 
 pub mod features;
+pub mod generate;
+pub mod mesh;
 pub mod stable;
