@@ -297,6 +297,21 @@ fn a_vertex_permutation_permutes_features_and_bands() {
     for (new, &old) in perm.iter().enumerate() {
         assert_eq!(bp.row(new), b.row(old), "vertex {new} (was {old})");
     }
+    let area = BandOptions {
+        bands: 20,
+        weighting: coseg::bands::BandWeighting::Area,
+    };
+    let (a, ap) = (
+        band_table(&f, &area).unwrap(),
+        band_table(&fp, &area).unwrap(),
+    );
+    for (new, &old) in perm.iter().enumerate() {
+        assert_eq!(
+            ap.row(new),
+            a.row(old),
+            "area bands, vertex {new} (was {old})"
+        );
+    }
     assert_eq!(bp.labels.len(), d * n);
 }
 

@@ -35,6 +35,9 @@ pub enum BandError {
     /// positive sum.
     #[error("bad vertex weights: {0}")]
     BadWeights(String),
+    /// More vertices than a `u32` index can address.
+    #[error("{0} vertices exceed the u32 index range")]
+    TooManyVertices(usize),
     /// A feature value is NaN.
     #[error("feature {feature} is NaN at vertex {vertex}")]
     NaN {
@@ -119,6 +122,9 @@ pub(crate) fn ranked_labels(
     weights: Option<&[f64]>,
 ) -> Result<BandTable, BandError> {
     use rayon::prelude::*;
+    if vertices > u32::MAX as usize {
+        return Err(BandError::TooManyVertices(vertices));
+    }
     if let Some(f) = (0..features).find(|&k| {
         values[k * vertices..(k + 1) * vertices]
             .iter()

@@ -51,7 +51,7 @@ pub enum FeatureKind {
 }
 
 impl FeatureKind {
-    /// A short name such as `hks_003` (family and index within the family).
+    /// The family name: `hks`, `wks` or `curv` (as in the column names).
     pub fn family(&self) -> &'static str {
         match self {
             FeatureKind::Hks(_) => "hks",
