@@ -24,7 +24,7 @@
 
 use crate::bands::{BandError, BandOptions, BandTable, band_table};
 use crate::features::{DescriptorOptions, Descriptors, FeatureError, descriptors};
-use crate::mesh::TriMesh;
+use crate::mesh::{TriMesh, write_atomic};
 use crate::spectral::{SpectralError, Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -272,7 +272,8 @@ pub fn load_or_compute(
         path: cache_dir.display().to_string(),
         source,
     })?;
-    let write_error = write_atomic(&path, &encode_entry(&data))
+    let entry = encode_entry(&data);
+    let write_error = write_atomic(&path, |w| w.write_all(&entry))
         .err()
         .map(|e| format!("{}: cache entry not written: {e}", path.display()));
     Ok(CacheResult {
@@ -347,36 +348,4 @@ fn decode_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeDa
         return Err("payload sizes do not match the mesh".into());
     }
     Ok(data)
-}
-
-/// Writes `bytes` to `path` atomically: a temporary file in the same directory, flushed to disk,
-/// then renamed over `path`. Readers see either the old file or the complete new one.
-pub(crate) fn write_atomic(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    use std::sync::atomic::{AtomicU64, Ordering};
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
-    let dir = path.parent().filter(|p| !p.as_os_str().is_empty());
-    let name = path
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_else(|| "out".into());
-    let tmp_name = format!(
-        ".{name}.tmp.{}.{}",
-        std::process::id(),
-        COUNTER.fetch_add(1, Ordering::Relaxed)
-    );
-    let tmp = match dir {
-        Some(d) => d.join(tmp_name),
-        None => PathBuf::from(tmp_name),
-    };
-    let result = (|| {
-        let mut f = std::fs::File::create(&tmp)?;
-        f.write_all(bytes)?;
-        f.sync_all()?;
-        drop(f);
-        std::fs::rename(&tmp, path)
-    })();
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    result
 }

@@ -224,3 +224,26 @@ fn band_table_uses_the_descriptors_vertex_areas() {
         (12, f.vertices, 20)
     );
 }
+
+#[test]
+fn large_skewed_and_tied_features_match_the_oracle() {
+    let d = 7001;
+    let mut values = Vec::new();
+    // Heavy tail, clusters of exact ties, both zeros, negatives, a wide dynamic range.
+    values.extend((0..d).map(|i| ((i * 37 % 101) as f64).powi(6)));
+    values.extend((0..d).map(|i| {
+        if i % 3 == 0 {
+            1.5
+        } else {
+            (i % 11) as f64 * 1e-300
+        }
+    }));
+    values.extend((0..d).map(|i| if i % 2 == 0 { 0.0 } else { -0.0 }));
+    values.extend((0..d).map(|i| ((i as f64) * 0.37).sin() * 1e12 + (i % 5) as f64 * 1e-3));
+    values.extend((0..d).map(|i| 1.0 + (i % 2) as f64 * f64::EPSILON));
+    let n = values.len() / d;
+    for k in [2, 7, 20, 64, 256] {
+        let t = equal_count_bands(&values, n, d, k).unwrap();
+        assert_eq!(t.labels, oracle(&values, n, d, k), "K = {k}");
+    }
+}

@@ -85,7 +85,10 @@ fn multiscale_curvature_of_a_sphere_is_the_unit_area_constant() {
     let s = dense_spectrum(&sphere, 40).unwrap();
     let times = [1e-3, 1e-2, 0.1];
     let h = multiscale_mean_curvature(&sphere, &s, &times).unwrap();
-    let expect = (4.0 * std::f64::consts::PI).sqrt();
+    // H = 1 at the vertices; unit-area scaling multiplies it by sqrt(area) (slightly below
+    // sqrt(4π) for the inscribed polyhedron).
+    let expect = sphere.total_area().sqrt();
+    assert!((expect / (4.0 * std::f64::consts::PI).sqrt() - 1.0).abs() < 1e-2);
     let worst = h
         .iter()
         .map(|x| (x / expect - 1.0).abs())
@@ -293,6 +296,21 @@ fn a_vertex_permutation_permutes_features_and_bands() {
     let n = f.feature_count();
     for (new, &old) in perm.iter().enumerate() {
         assert_eq!(bp.row(new), b.row(old), "vertex {new} (was {old})");
+    }
+    let area = BandOptions {
+        bands: 20,
+        weighting: coseg::bands::BandWeighting::Area,
+    };
+    let (a, ap) = (
+        band_table(&f, &area).unwrap(),
+        band_table(&fp, &area).unwrap(),
+    );
+    for (new, &old) in perm.iter().enumerate() {
+        assert_eq!(
+            ap.row(new),
+            a.row(old),
+            "area bands, vertex {new} (was {old})"
+        );
     }
     assert_eq!(bp.labels.len(), d * n);
 }

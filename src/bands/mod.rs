@@ -35,6 +35,9 @@ pub enum BandError {
     /// positive sum.
     #[error("bad vertex weights: {0}")]
     BadWeights(String),
+    /// More vertices than a `u32` index can address.
+    #[error("{0} vertices exceed the u32 index range")]
+    TooManyVertices(usize),
     /// A feature value is NaN.
     #[error("feature {feature} is NaN at vertex {vertex}")]
     NaN {
@@ -119,6 +122,9 @@ pub(crate) fn ranked_labels(
     weights: Option<&[f64]>,
 ) -> Result<BandTable, BandError> {
     use rayon::prelude::*;
+    if vertices > u32::MAX as usize {
+        return Err(BandError::TooManyVertices(vertices));
+    }
     if let Some(f) = (0..features).find(|&k| {
         values[k * vertices..(k + 1) * vertices]
             .iter()
@@ -138,30 +144,31 @@ pub(crate) fn ranked_labels(
         .into_par_iter()
         .map_init(Vec::new, |keys: &mut Vec<u128>, k| {
             let f = &values[k * vertices..(k + 1) * vertices];
+            // Unique keys: (value in total order, vertex index).
             keys.clear();
-            keys.extend(
-                f.iter()
-                    .enumerate()
-                    .map(|(v, &x)| ((order_bits(x) as u128) << 32) | v as u128),
-            );
-            keys.sort_unstable();
+            keys.extend(f.iter().enumerate().map(|(v, &x)| key(x, v)));
             let mut col = vec![0u8; vertices];
             match weights {
+                None if vertices >= 2 * bands => {
+                    bucket_count_bands(f, bands, keys, &mut col);
+                }
                 None => {
+                    keys.sort_unstable();
                     let (base, extra) = (vertices / bands, vertices % bands);
                     let mut pos = 0usize;
                     for band in 0..bands {
                         let size = base + usize::from(band < extra);
-                        for &key in &keys[pos..pos + size] {
-                            col[(key as u32) as usize] = band as u8;
+                        for &kv in &keys[pos..pos + size] {
+                            col[(kv as u32) as usize] = band as u8;
                         }
                         pos += size;
                     }
                 }
                 Some(w) => {
+                    keys.sort_unstable();
                     let mut before = 0.0f64;
-                    for &key in keys.iter() {
-                        let v = (key as u32) as usize;
+                    for &kv in keys.iter() {
+                        let v = (kv as u32) as usize;
                         let mid = before + 0.5 * w[v];
                         before += w[v];
                         let b = ((mid / total) * bands as f64).floor();
@@ -172,11 +179,22 @@ pub(crate) fn ranked_labels(
             col
         })
         .collect();
+    // Transpose to vertex-major, in parallel over fixed blocks of vertices (pure copies).
+    const VERTEX_BLOCK: usize = 1024;
     let mut labels = vec![0u8; features * vertices];
-    for (k, col) in columns.iter().enumerate() {
-        for (v, &b) in col.iter().enumerate() {
-            labels[v * features + k] = b;
-        }
+    if features > 0 {
+        labels
+            .par_chunks_mut(features * VERTEX_BLOCK)
+            .enumerate()
+            .for_each(|(block, out)| {
+                let v0 = block * VERTEX_BLOCK;
+                let n = out.len() / features;
+                for (k, col) in columns.iter().enumerate() {
+                    for (i, &b) in col[v0..v0 + n].iter().enumerate() {
+                        out[i * features + k] = b;
+                    }
+                }
+            });
     }
     Ok(BandTable {
         features,
@@ -191,4 +209,84 @@ pub(crate) fn ranked_labels(
 fn order_bits(x: f64) -> u64 {
     let b = x.to_bits();
     if b >> 63 == 1 { !b } else { b | (1 << 63) }
+}
+
+/// The sort key of value `x` at vertex `v`: `total_cmp` order, then vertex index. Unique.
+#[inline]
+fn key(x: f64, v: usize) -> u128 {
+    ((order_bits(x) as u128) << 32) | v as u128
+}
+
+/// Buckets of [`bucket_count_bands`]: `2^BUCKET_BITS`.
+const BUCKET_BITS: u32 = 14;
+
+/// Equal-count labels of one feature without a full sort, identical to sorting by
+/// `(value, index)` and cutting: a counting pass over `2^14` buckets of the order-preserving
+/// key; a bucket whose ranks fall in one band labels all its vertices at once; the few buckets
+/// that straddle a cut are sorted exactly (by key, then index). `vertices ≥ 2 · bands`.
+fn bucket_count_bands(f: &[f64], bands: usize, scratch: &mut Vec<u128>, col: &mut [u8]) {
+    let d = f.len();
+    let (base, extra) = (d / bands, d % bands);
+    // Band of rank r: blocks of size base + 1 first, then base.
+    let big = extra * (base + 1);
+    let band_of_rank = |r: usize| -> u8 {
+        if r < big {
+            (r / (base + 1)) as u8
+        } else {
+            (extra + (r - big) / base) as u8
+        }
+    };
+    let (mut lo, mut hi) = (u64::MAX, 0u64);
+    for &x in f {
+        let k = order_bits(x);
+        lo = lo.min(k);
+        hi = hi.max(k);
+    }
+    let range = hi - lo;
+    let shift = (64 - range.leading_zeros()).saturating_sub(BUCKET_BITS);
+    let bucket = |x: f64| ((order_bits(x) - lo) >> shift) as usize;
+    let nb = ((range >> shift) as usize) + 1;
+    let mut start = vec![0usize; nb + 1];
+    for &x in f {
+        start[bucket(x) + 1] += 1;
+    }
+    for b in 0..nb {
+        start[b + 1] += start[b];
+    }
+    // The label of a bucket whose ranks all fall in one band; None if it straddles a cut.
+    let uniform: Vec<Option<u8>> = (0..nb)
+        .map(|b| {
+            let (s, e) = (start[b], start[b + 1]);
+            if s == e {
+                return Some(0);
+            }
+            let (first, last) = (band_of_rank(s), band_of_rank(e - 1));
+            (first == last).then_some(first)
+        })
+        .collect();
+    scratch.clear();
+    for (v, (&x, c)) in f.iter().zip(col.iter_mut()).enumerate() {
+        let b = bucket(x);
+        match uniform[b] {
+            Some(label) => *c = label,
+            // Straddling: sort key (bucket, value order, index), all fit in 128 bits
+            // because the bucket is a function of the value order.
+            None => scratch.push(((order_bits(x) as u128) << 32) | v as u128),
+        }
+    }
+    scratch.sort_unstable();
+    // Walk the straddling elements bucket by bucket (sorted by value, so by bucket too).
+    let mut i = 0;
+    while i < scratch.len() {
+        let x_bits = (scratch[i] >> 32) as u64;
+        let b = ((x_bits - lo) >> shift) as usize;
+        let s = start[b];
+        let mut j = i;
+        while j < scratch.len() && ((((scratch[j] >> 32) as u64) - lo) >> shift) as usize == b {
+            let v = (scratch[j] as u32) as usize;
+            col[v] = band_of_rank(s + (j - i));
+            j += 1;
+        }
+        i = j;
+    }
 }

@@ -1,9 +1,11 @@
-use super::{
-    FeatureError, SpectralBand, heat_kernel_signature, multiscale_mean_curvature, scale_grid,
-    wave_kernel_signature,
-};
+use super::heat_kernel_signature::hks_coefficients;
+use super::multiscale_mean_curvature::curvature_coefficients;
+use super::spectral_product::spectral_product;
+use super::wave_kernel_signature::wks_coefficients;
+use super::{FeatureError, SpectralBand, scale_grid};
 use crate::mesh::TriMesh;
 use crate::spectral::Spectrum;
+use faer::Mat;
 
 /// Options of [`descriptors`]. Every field changes the result (and so belongs in a cache key).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -49,7 +51,7 @@ pub enum FeatureKind {
 }
 
 impl FeatureKind {
-    /// A short name such as `hks_003` (family and index within the family).
+    /// The family name: `hks`, `wks` or `curv` (as in the column names).
     pub fn family(&self) -> &'static str {
         match self {
             FeatureKind::Hks(_) => "hks",
@@ -178,26 +180,28 @@ pub fn descriptors(
         options.curvature_count,
         options.wks_sigma_multiple,
     )?;
-    let (hks, (wks, curv)) = rayon::join(
-        || heat_kernel_signature(spectrum, &grid.hks_times),
-        || {
-            rayon::join(
-                || {
-                    wave_kernel_signature(
-                        spectrum,
-                        &grid.wks_energies,
-                        grid.wks_sigma,
-                        options.zero_eigenvalue,
-                    )
-                },
-                || multiscale_mean_curvature(mesh, spectrum, &grid.curvature_times),
-            )
-        },
+    // One pass over Φ: [HKS; WKS] use φ², curvature uses φ.
+    let lambda = &spectrum.eigenvalues;
+    let hks = hks_coefficients(lambda, &grid.hks_times);
+    let wks = wks_coefficients(
+        lambda,
+        &grid.wks_energies,
+        grid.wks_sigma,
+        options.zero_eigenvalue,
     );
-    let curv = curv?;
-    let mut values = hks;
-    values.extend_from_slice(&wks);
-    values.extend_from_slice(&curv);
+    let squared = Mat::from_fn(hks.nrows() + wks.nrows(), lambda.len(), |j, i| {
+        if j < hks.nrows() {
+            hks[(j, i)]
+        } else {
+            wks[(j - hks.nrows(), i)]
+        }
+    });
+    let plain = curvature_coefficients(mesh, spectrum, &grid.curvature_times);
+    let values = spectral_product(
+        spectrum.eigenvector_matrix(),
+        squared.as_ref(),
+        plain.as_ref(),
+    );
     Ok(Descriptors {
         vertices: d,
         hks_times: grid.hks_times,

@@ -1,7 +1,8 @@
 use super::{Descriptors, FeatureError};
 use crate::bands::BandTable;
-use crate::cache::write_atomic;
+use crate::mesh::write_atomic;
 use crate::spectral::Spectrum;
+use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// File format of [`export_features`].
@@ -60,7 +61,7 @@ pub fn export_features(
     let mut written = Vec::new();
     let mut put = |name: &str, bytes: Vec<u8>| -> Result<(), FeatureError> {
         let path = dir.join(name);
-        write_atomic(&path, &bytes).map_err(|source| FeatureError::Io {
+        write_atomic(&path, |w| w.write_all(&bytes)).map_err(|source| FeatureError::Io {
             path: path.display().to_string(),
             source,
         })?;

@@ -17,9 +17,18 @@ use faer::Mat;
 /// assert_eq!(heat_kernel_signature(&s, &[0.1]), vec![1.0]);
 /// ```
 pub fn heat_kernel_signature(spectrum: &Spectrum, times: &[f64]) -> Vec<f64> {
-    let lambda = &spectrum.eigenvalues;
-    let coeffs = Mat::from_fn(times.len(), lambda.len(), |j, i| {
+    let coeffs = hks_coefficients(&spectrum.eigenvalues, times);
+    let none = Mat::<f64>::zeros(0, spectrum.len());
+    spectral_product(
+        spectrum.eigenvector_matrix(),
+        coeffs.as_ref(),
+        none.as_ref(),
+    )
+}
+
+/// `C[(j, i)] = exp(−λ_i t_j)`.
+pub(crate) fn hks_coefficients(lambda: &[f64], times: &[f64]) -> Mat<f64> {
+    Mat::from_fn(times.len(), lambda.len(), |j, i| {
         (-lambda[i] * times[j]).exp()
-    });
-    spectral_product(spectrum.eigenvector_matrix(), coeffs.as_ref(), true)
+    })
 }

@@ -1,4 +1,5 @@
-use crate::mesh::TriMesh;
+use crate::mesh::{TriMesh, cross, dot, norm, sub};
+#[cfg(test)]
 use crate::spectral::cotan_laplacian;
 
 /// Pointwise mean curvature `H` (length `d`, units 1/file length) from the cotangent Laplacian
@@ -24,19 +25,7 @@ use crate::spectral::cotan_laplacian;
 /// ```
 pub fn mean_curvature(mesh: &TriMesh) -> Vec<f64> {
     let d = mesh.vertex_count();
-    let l = cotan_laplacian(mesh);
-    let x = mesh.positions();
-    let mut lx = vec![[0.0f64; 3]; d];
-    // L is symmetric: column j holds row j.
-    for (j, lxj) in lx.iter_mut().enumerate() {
-        let rows = l.as_ref().row_idx_of_col_raw(j);
-        let vals = l.as_ref().val_of_col(j);
-        for (&i, &w) in rows.iter().zip(vals) {
-            for c in 0..3 {
-                lxj[c] += w * x[i][c];
-            }
-        }
-    }
+    let lx = cotan_laplacian_times_positions(mesh);
     let mass = mixed_voronoi_areas(mesh);
     let normals = mesh.vertex_normals();
     (0..d)
@@ -50,6 +39,37 @@ pub fn mean_curvature(mesh: &TriMesh) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// Same clamp as [`cotan_laplacian`](crate::spectral::cotan_laplacian) (its `MAX_COTANGENT`).
+const MAX_COTANGENT: f64 = 1e5;
+
+/// `L X` for the cotangent Laplacian `L` of [`cotan_laplacian`](crate::spectral::cotan_laplacian)
+/// (same weights, clamp and degenerate-triangle rule), assembled face by face without building
+/// the sparse matrix: `(L X)_i = Σ_j w_ij (x_i − x_j)`.
+pub(crate) fn cotan_laplacian_times_positions(mesh: &TriMesh) -> Vec<[f64; 3]> {
+    let x = mesh.positions();
+    let mut lx = vec![[0.0f64; 3]; mesh.vertex_count()];
+    for (f, idx) in mesh.faces().iter().enumerate() {
+        let p = mesh.corners(f);
+        for k in 0..3 {
+            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+            let u = sub(p[i], p[k]);
+            let v = sub(p[j], p[k]);
+            let c = norm(cross(u, v));
+            if c.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
+                continue;
+            }
+            let w = 0.5 * (dot(u, v) / c).clamp(-MAX_COTANGENT, MAX_COTANGENT);
+            let (a, b) = (idx[i] as usize, idx[j] as usize);
+            for c in 0..3 {
+                let e = w * (x[a][c] - x[b][c]);
+                lx[a][c] += e;
+                lx[b][c] -= e;
+            }
+        }
+    }
+    lx
 }
 
 /// Mixed Voronoi vertex areas (Meyer, Desbrun, Schröder, Barr 2003): the Voronoi area inside
@@ -93,4 +113,41 @@ fn mixed_voronoi_areas(mesh: &TriMesh) -> Vec<f64> {
         }
     }
     a
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_assembly_equals_the_sparse_laplacian() {
+        let mesh = TriMesh::new(
+            vec![
+                [0.0, 0.0, 0.1],
+                [1.0, 0.0, 0.0],
+                [1.2, 1.0, 0.3],
+                [0.0, 1.0, -0.2],
+                [0.5, 0.4, 0.9],
+            ],
+            vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
+        )
+        .unwrap();
+        let lx = cotan_laplacian_times_positions(&mesh);
+        let l = cotan_laplacian(&mesh);
+        for (j, got) in lx.iter().enumerate() {
+            let rows = l.as_ref().row_idx_of_col_raw(j);
+            let vals = l.as_ref().val_of_col(j);
+            let mut want = [0.0; 3];
+            for (&i, &w) in rows.iter().zip(vals) {
+                for (c, out) in want.iter_mut().enumerate() {
+                    *out += w * mesh.positions()[i][c];
+                }
+            }
+            for c in 0..3 {
+                assert!((got[c] - want[c]).abs() < 1e-12, "{j} {c}");
+            }
+        }
+        let total: f64 = mixed_voronoi_areas(&mesh).iter().sum();
+        assert!((total - mesh.total_area()).abs() < 1e-12);
+    }
 }

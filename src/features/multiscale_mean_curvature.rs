@@ -33,6 +33,22 @@ pub fn multiscale_mean_curvature(
             spectrum: spectrum.vertex_count(),
         });
     }
+    let coeffs = curvature_coefficients(mesh, spectrum, times);
+    let none = Mat::<f64>::zeros(0, spectrum.len());
+    Ok(spectral_product(
+        spectrum.eigenvector_matrix(),
+        none.as_ref(),
+        coeffs.as_ref(),
+    ))
+}
+
+/// `C[(j, i)] = exp(−λ_i t_j) ⟨φ_i, H⟩_M` with `H` the unit-area mean curvature.
+/// The mesh and spectrum must have the same vertex count.
+pub(crate) fn curvature_coefficients(
+    mesh: &TriMesh,
+    spectrum: &Spectrum,
+    times: &[f64],
+) -> Mat<f64> {
     let scale = mesh.total_area().sqrt();
     let weighted: Vec<f64> = mean_curvature(mesh)
         .iter()
@@ -52,12 +68,7 @@ pub fn multiscale_mean_curvature(
         })
         .collect();
     let lambda = &spectrum.eigenvalues;
-    let coeffs = Mat::from_fn(times.len(), lambda.len(), |j, i| {
+    Mat::from_fn(times.len(), lambda.len(), |j, i| {
         (-lambda[i] * times[j]).exp() * proj[i]
-    });
-    Ok(spectral_product(
-        spectrum.eigenvector_matrix(),
-        coeffs.as_ref(),
-        false,
-    ))
+    })
 }

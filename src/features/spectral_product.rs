@@ -1,5 +1,6 @@
-//! The one dense kernel every spectral feature uses: `out = g(Φ) · Cᵀ` with `g` either the
-//! identity or the entrywise square, computed in fixed row blocks so that the result is
+//! The one dense kernel every spectral feature uses:
+//! `out = [Φ∘Φ · Sᵀ | Φ · Pᵀ]` (entrywise square times the "squared" coefficients, then Φ
+//! times the "plain" coefficients), computed in fixed row blocks so that the result is
 //! bit-identical whatever the number of threads.
 
 use faer::linalg::matmul::matmul;
@@ -8,58 +9,69 @@ use rayon::prelude::*;
 
 /// Rows per block. Fixed (never derived from the thread count) so that the floating-point
 /// operations, hence the result bits, do not depend on the machine.
-const BLOCK_ROWS: usize = 1024;
+const BLOCK_ROWS: usize = 512;
 
-/// `out[f * d + v] = Σ_i coeffs[(f, i)] · g(φ_i(v))` where `g(x) = x²` when `square`, else `x`.
+/// `out[f * d + v]`, for `f < S`: `Σ_i squared[(f, i)] φ_i(v)²`; for `f = S + g`:
+/// `Σ_i plain[(g, i)] φ_i(v)`.
 ///
-/// `phi` is `d × k` column-major, `coeffs` is `T × k`. Returns a `d × T` column-major vector
-/// (feature-major). Each row block is one sequential GEMM; blocks run in parallel (rayon).
+/// `phi` is `d × k` column-major, `squared` is `S × k`, `plain` is `P × k`. Returns
+/// `(S + P) × d` values, feature-major. Each row block is one sequential GEMM per
+/// coefficient matrix; blocks run in parallel (rayon) and are scattered in block order.
 pub(crate) fn spectral_product(
     phi: MatRef<'_, f64>,
-    coeffs: MatRef<'_, f64>,
-    square: bool,
+    squared: MatRef<'_, f64>,
+    plain: MatRef<'_, f64>,
 ) -> Vec<f64> {
     let (d, k) = (phi.nrows(), phi.ncols());
-    let t = coeffs.nrows();
-    debug_assert_eq!(coeffs.ncols(), k);
+    let (ns, np) = (squared.nrows(), plain.nrows());
+    debug_assert!(squared.ncols() == k && plain.ncols() == k);
+    let t = ns + np;
     let mut out = vec![0.0; d * t];
     if d == 0 || t == 0 {
         return out;
     }
-    let coeffs_t = coeffs.transpose();
     let blocks: Vec<(usize, Mat<f64>)> = (0..d.div_ceil(BLOCK_ROWS))
         .into_par_iter()
         .map(|b| {
             let r0 = b * BLOCK_ROWS;
             let n = BLOCK_ROWS.min(d - r0);
             let rows = phi.subrows(r0, n);
-            let lhs = if square {
-                Mat::from_fn(n, k, |i, j| {
+            let mut dst = Mat::<f64>::zeros(n, t);
+            if ns > 0 {
+                let sq = Mat::from_fn(n, k, |i, j| {
                     let x = rows[(i, j)];
                     x * x
-                })
-            } else {
-                rows.to_owned()
-            };
-            let mut dst = Mat::<f64>::zeros(n, t);
-            matmul(
-                dst.as_mut(),
-                Accum::Replace,
-                lhs.as_ref(),
-                coeffs_t,
-                1.0,
-                Par::Seq,
-            );
+                });
+                matmul(
+                    dst.as_mut().subcols_mut(0, ns),
+                    Accum::Replace,
+                    sq.as_ref(),
+                    squared.transpose(),
+                    1.0,
+                    Par::Seq,
+                );
+            }
+            if np > 0 {
+                matmul(
+                    dst.as_mut().subcols_mut(ns, np),
+                    Accum::Replace,
+                    rows,
+                    plain.transpose(),
+                    1.0,
+                    Par::Seq,
+                );
+            }
             (r0, dst)
         })
         .collect();
-    for (r0, dst) in blocks {
-        for f in 0..t {
-            let col = &mut out[f * d + r0..f * d + r0 + dst.nrows()];
-            for (i, o) in col.iter_mut().enumerate() {
-                *o = dst[(i, f)];
+    // Scatter in parallel over features (disjoint output columns; pure copies).
+    out.par_chunks_mut(d).enumerate().for_each(|(f, col)| {
+        for (r0, dst) in &blocks {
+            let src = dst.col(f);
+            for (i, o) in col[*r0..*r0 + dst.nrows()].iter_mut().enumerate() {
+                *o = src[i];
             }
         }
-    }
+    });
     out
 }

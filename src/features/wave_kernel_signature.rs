@@ -27,7 +27,22 @@ pub fn wave_kernel_signature(
     sigma: f64,
     zero_eigenvalue: f64,
 ) -> Vec<f64> {
-    let lambda = &spectrum.eigenvalues;
+    let coeffs = wks_coefficients(&spectrum.eigenvalues, energies, sigma, zero_eigenvalue);
+    let none = Mat::<f64>::zeros(0, spectrum.len());
+    spectral_product(
+        spectrum.eigenvector_matrix(),
+        coeffs.as_ref(),
+        none.as_ref(),
+    )
+}
+
+/// `C[(j, i)] = w_i(e_j) / Σ_i w_i(e_j)` (0 for excluded eigenpairs).
+pub(crate) fn wks_coefficients(
+    lambda: &[f64],
+    energies: &[f64],
+    sigma: f64,
+    zero_eigenvalue: f64,
+) -> Mat<f64> {
     let log_lambda: Vec<Option<f64>> = lambda
         .iter()
         .map(|&l| (l > zero_eigenvalue).then(|| l.ln()))
@@ -55,5 +70,5 @@ pub fn wave_kernel_signature(
             coeffs[(j, i)] = wi / total;
         }
     }
-    spectral_product(spectrum.eigenvector_matrix(), coeffs.as_ref(), true)
+    coeffs
 }
