@@ -83,6 +83,33 @@ pub struct BandAffinity<'a> {
     /// Identity pairing with the same feature count on both sides.
     identity: bool,
     unit: f64,
+    /// Pair labels `l_{2i} K + l_{2i+1}` of A and B (vertex-major, `ceil(N/2)` per vertex) when
+    /// `K ≤ PAIR_MAX_BANDS`: the integer gather then reads one `u16` and one table entry per two
+    /// features.
+    pair_labels: Option<(Vec<u16>, Vec<u16>)>,
+}
+
+/// Largest `K` for which the paired gather is used (its table has `ceil(N/2) K²` entries).
+const PAIR_MAX_BANDS: usize = 32;
+
+/// Pair labels of a table: `out[v * P + i] = l(v, 2i) K + l(v, 2i + 1)` (`0` past the last
+/// feature).
+fn pair_labels(t: &BandTable) -> Vec<u16> {
+    let (nf, k) = (t.features, t.bands);
+    let np = nf.div_ceil(2);
+    let mut out = vec![0u16; t.vertices * np];
+    out.par_chunks_mut(np * 1024)
+        .zip(t.labels.par_chunks(nf * 1024))
+        .for_each(|(o, l)| {
+            for (orow, lrow) in o.chunks_exact_mut(np).zip(l.chunks_exact(nf)) {
+                for (i, x) in orow.iter_mut().enumerate() {
+                    let l0 = lrow[2 * i] as u16;
+                    let l1 = lrow.get(2 * i + 1).map_or(0, |&v| v as u16);
+                    *x = l0 * k as u16 + l1;
+                }
+            }
+        });
+    out
 }
 
 /// Reusable buffers of a [`BandAffinity`]: products allocate nothing once it exists.
@@ -92,6 +119,7 @@ pub struct AffinityWorkspace {
     hist_f: Vec<f64>,
     table_u: Vec<u32>,
     table_f: Vec<f64>,
+    table_pair: Vec<u32>,
     support: Vec<u32>,
 }
 
@@ -103,6 +131,10 @@ impl AffinityWorkspace {
             self.hist_f.resize(SCATTER_CHUNKS * len, 0.0);
             self.table_u.resize(len, 0);
             self.table_f.resize(len, 0.0);
+            if bands <= PAIR_MAX_BANDS {
+                self.table_pair
+                    .resize(features.div_ceil(2) * bands * bands, 0);
+            }
         }
     }
 }
@@ -212,6 +244,8 @@ impl<'a> BandAffinity<'a> {
                 .enumerate()
                 .all(|(i, &(x, y))| x as usize == i && y as usize == i);
         let unit = a.bands as f64 / (n as f64 * a.vertices as f64 * b.vertices as f64);
+        let pair_labels = (raw_weights.is_none() && a.bands <= PAIR_MAX_BANDS)
+            .then(|| (pair_labels(a), pair_labels(b)));
         Ok(Self {
             a,
             b,
@@ -220,7 +254,15 @@ impl<'a> BandAffinity<'a> {
             raw_weights,
             identity,
             unit,
+            pair_labels,
         })
+    }
+
+    /// Disables the paired gather (benchmarks compare both; results are identical).
+    #[doc(hidden)]
+    pub fn without_pair_gather(mut self) -> Self {
+        self.pair_labels = None;
+        self
     }
 
     /// `d_b`, the number of rows of `W`.
@@ -370,12 +412,10 @@ impl<'a> BandAffinity<'a> {
         let nk = dst.features * self.bands;
         if self.raw_weights.is_none() {
             scatter_count(src, self.bands, support, &mut ws.hist_u);
-            if self.identity {
-                gather(dst, self.bands, &ws.hist_u[..nk], rows, out, |s| s);
-            } else {
+            let k = self.bands;
+            if !self.identity {
                 let table = &mut ws.table_u[..nk];
                 table.fill(0);
-                let k = self.bands;
                 for &(ka, kb) in &self.pairs {
                     let (s, d) = pick(dir, ka, kb);
                     let h = &ws.hist_u[s * k..(s + 1) * k];
@@ -383,7 +423,21 @@ impl<'a> BandAffinity<'a> {
                         *t += c;
                     }
                 }
-                gather(dst, self.bands, table, rows, out, |s| s);
+            }
+            let table: &[u32] = if self.identity {
+                &ws.hist_u[..nk]
+            } else {
+                &ws.table_u[..nk]
+            };
+            match &self.pair_labels {
+                Some((pa, pb)) => {
+                    let labels = if dir == Direction::AtoB { pb } else { pa };
+                    let np = dst.features.div_ceil(2);
+                    let t2 = &mut ws.table_pair[..np * k * k];
+                    build_pair_table(table, dst.features, k, t2);
+                    gather_pairs(labels, np, k * k, t2, rows, out);
+                }
+                None => gather(dst, k, table, rows, out, |s| s),
             }
         } else {
             // Weighted pairing: histogram of the 0/1 vector in f64 (exact counts), then mix.
@@ -609,6 +663,82 @@ fn gather<T: Bin>(
                 .for_each(|(o, idx)| {
                     for (v, &q) in o.iter_mut().zip(idx) {
                         *v = post(row_sum(table, dst.row(q as usize), bands));
+                    }
+                });
+        }
+    }
+}
+
+/// `t2[i K² + l K + m] = table[2i K + l] + table[(2i + 1) K + m]` (second term `0` past the last
+/// feature).
+fn build_pair_table(table: &[u32], features: usize, k: usize, t2: &mut [u32]) {
+    for (i, blk) in t2.chunks_exact_mut(k * k).enumerate() {
+        let h0 = &table[2 * i * k..(2 * i + 1) * k];
+        let h1 = table
+            .get((2 * i + 1) * k..(2 * i + 2) * k)
+            .filter(|_| 2 * i + 1 < features);
+        for (l, row) in blk.chunks_exact_mut(k).enumerate() {
+            match h1 {
+                Some(h1) => {
+                    for (x, &m) in row.iter_mut().zip(h1) {
+                        *x = h0[l] + m;
+                    }
+                }
+                None => row.fill(h0[l]),
+            }
+        }
+    }
+}
+
+/// Sum of `t2[i K² + pl[i]]` with four accumulators.
+#[inline(always)]
+fn pair_row_sum(t2: &[u32], pl: &[u16], kk: usize) -> f64 {
+    debug_assert_eq!(t2.len(), pl.len() * kk);
+    let mut acc = [0u64; 4];
+    let quads = pl.len() / 4;
+    // SAFETY: pair labels are built as `l0 K + l1` from labels `< K` (validated at construction),
+    // so `pl[i] < K² = kk` and `i kk + pl[i] < pl.len() kk = t2.len()`.
+    unsafe {
+        for q in 0..quads {
+            let i = 4 * q;
+            for (j, a) in acc.iter_mut().enumerate() {
+                let ii = i + j;
+                *a += *t2.get_unchecked(ii * kk + *pl.get_unchecked(ii) as usize) as u64;
+            }
+        }
+        for ii in 4 * quads..pl.len() {
+            acc[0] += *t2.get_unchecked(ii * kk + *pl.get_unchecked(ii) as usize) as u64;
+        }
+    }
+    ((acc[0] + acc[1]) + (acc[2] + acc[3])) as f64
+}
+
+/// The paired integer gather (see [`gather`]).
+fn gather_pairs(
+    labels: &[u16],
+    np: usize,
+    kk: usize,
+    t2: &[u32],
+    rows: Option<&[u32]>,
+    out: &mut [f64],
+) {
+    match rows {
+        None => {
+            out.par_chunks_mut(GATHER_BLOCK)
+                .zip(labels.par_chunks(GATHER_BLOCK * np))
+                .for_each(|(o, l)| {
+                    for (v, row) in o.iter_mut().zip(l.chunks_exact(np)) {
+                        *v = pair_row_sum(t2, row, kk);
+                    }
+                });
+        }
+        Some(r) => {
+            out.par_chunks_mut(GATHER_BLOCK)
+                .zip(r.par_chunks(GATHER_BLOCK))
+                .for_each(|(o, idx)| {
+                    for (v, &q) in o.iter_mut().zip(idx) {
+                        let q = q as usize;
+                        *v = pair_row_sum(t2, &labels[q * np..(q + 1) * np], kk);
                     }
                 });
         }

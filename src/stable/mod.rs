@@ -25,9 +25,9 @@ pub use stable_pairs_auto::stable_pairs_auto;
 pub use stable_pairs_fixed::stable_pairs_fixed;
 pub use stable_regions::{
     Algorithm, AreaReference, AutoThreshold, RegionPair, StableRegions, StableRegionsOptions,
-    stable_regions,
+    TSearch, stable_regions,
 };
-pub use threshold::{Threshold, threshold};
+pub use threshold::{Threshold, ThresholdScratch, threshold};
 
 use crate::affinity::AffinityError;
 use thiserror::Error;

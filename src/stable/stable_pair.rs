@@ -1,6 +1,6 @@
 //! [`stable_pair`]: Algorithm 1, a stable pair of regions from an initial indicator.
 
-use super::{StableError, Threshold, threshold};
+use super::{StableError, Threshold, ThresholdScratch, threshold};
 use crate::affinity::{AffinityWorkspace, BandAffinity, Direction};
 use serde::{Deserialize, Serialize};
 
@@ -72,7 +72,7 @@ pub struct StableWorkspace {
     pub affinity: AffinityWorkspace,
     scores_a: Vec<f64>,
     scores_b: Vec<f64>,
-    scratch: Vec<u32>,
+    scratch: ThresholdScratch,
 }
 
 /// Sorted intersection of two ascending lists.

@@ -1,12 +1,14 @@
 //! [`stable_pairs_auto`]: Algorithm 3, stable pairs with automatic thresholds.
 
 use super::stable_pairs_fixed::Extraction;
-use super::stable_regions::{AutoThreshold, StableRegions, StableRegionsOptions};
+use super::stable_regions::{AutoThreshold, StableRegions, StableRegionsOptions, TSearch};
 use super::{StableError, StablePairOptions, Threshold, initial_indicator};
 use crate::affinity::BandAffinity;
 
-/// Algorithm 3: for each of the first `K − 1` pairs, raise `t = 0, δt, 2δt, …` while
-/// Algorithm 1 with `P[τ_t]`, `Q[τ_t]` still returns a non-empty pair (up to `t_max`); with the
+/// Algorithm 3: for each of the first `K − 1` pairs, find the largest `t ∈ {0, δt, 2δt, …}`
+/// (up to `t_max`) for which Algorithm 1 with `P[τ_t]`, `Q[τ_t]` returns a non-empty pair —
+/// stepping up one `δt` at a time as the paper does ([`TSearch::Linear`]) or by galloping and
+/// bisection, which assumes emptiness is monotone in `t` ([`TSearch::Bisect`]); with the
 /// last non-empty pair `(Ω^t_A, Ω^t_B)` set `α = max(α_A, α_B)` (fractions of the remaining
 /// areas) and run Algorithm 1 with `P_α`, `Q_α` from `1_{Ω^t_A}`; remove the pair. The
 /// leftovers form the last pair. Stops early when even `t = 0` gives an empty pair.
@@ -40,25 +42,74 @@ pub fn stable_pairs_auto(
         }
         let (rem_area_a, rem_area_b) = (ex.remaining_area_a(), ex.remaining_area_b());
         let f_in = initial_indicator(w, &ex.rem_a, options.init, options.seed, i);
-        let mut start = f_in.clone();
-        let mut last = None;
         let mut search_iterations = 0;
-        for s in 0..=steps {
+        let mut start = f_in.clone();
+        // Runs Algorithm 1 with P[τ_t], Q[τ_t] at step s; `None` when the pair is empty.
+        let mut probe = |s: usize, start: &[u32], ex: &mut Extraction<'_>| {
             let t = s as f64 * options.delta_t;
             let opts = StablePairOptions {
                 p: Threshold::MeanStd(t),
                 q: Threshold::MeanStd(t),
                 max_iterations: options.max_iterations,
             };
-            let pair = ex.run(w, &start, &opts, (rem_area_a, rem_area_b))?;
+            let pair = ex.run(w, start, &opts, (rem_area_a, rem_area_b))?;
             search_iterations += pair.iterations;
-            if pair.region_a.is_empty() || pair.region_b.is_empty() {
-                break;
+            Ok::<_, StableError>(
+                (!pair.region_a.is_empty() && !pair.region_b.is_empty()).then_some((t, pair)),
+            )
+        };
+        let mut last = None;
+        match options.t_search {
+            TSearch::Linear => {
+                for s in 0..=steps {
+                    let Some(found) = probe(s, &start, &mut ex)? else {
+                        break;
+                    };
+                    if options.warm_start {
+                        start.clone_from(&found.1.region_a);
+                    }
+                    last = Some(found);
+                }
             }
-            if options.warm_start {
-                start.clone_from(&pair.region_a);
+            TSearch::Bisect => {
+                // Gallop s = 0, 1, 2, 4, … to the first empty step, then bisect.
+                let (mut good, mut bad) = (None::<usize>, None::<usize>);
+                let mut s = 0;
+                loop {
+                    match probe(s, &start, &mut ex)? {
+                        Some(found) => {
+                            if options.warm_start {
+                                start.clone_from(&found.1.region_a);
+                            }
+                            good = Some(s);
+                            last = Some(found);
+                            if s == steps {
+                                break;
+                            }
+                            s = if s == 0 { 1 } else { (2 * s).min(steps) };
+                        }
+                        None => {
+                            bad = Some(s);
+                            break;
+                        }
+                    }
+                }
+                if let (Some(mut lo), Some(mut hi)) = (good, bad) {
+                    while hi - lo > 1 {
+                        let mid = lo + (hi - lo) / 2;
+                        match probe(mid, &start, &mut ex)? {
+                            Some(found) => {
+                                if options.warm_start {
+                                    start.clone_from(&found.1.region_a);
+                                }
+                                lo = mid;
+                                last = Some(found);
+                            }
+                            None => hi = mid,
+                        }
+                    }
+                }
             }
-            last = Some((t, pair));
         }
         let Some((t, pt)) = last else { break };
         let alpha =
