@@ -22,15 +22,50 @@ use std::time::Instant;
 
 fn configs() -> Vec<(&'static str, StableRegionsOptions)> {
     let base = StableRegionsOptions::default();
-    let auto = StableRegionsOptions { algorithm: Algorithm::Auto, ..base.clone() };
+    let auto = StableRegionsOptions {
+        algorithm: Algorithm::Auto,
+        ..base.clone()
+    };
     vec![
         ("alg2-extreme", base.clone()),
-        ("alg2-random", StableRegionsOptions { init: Init::Random, ..base.clone() }),
-        ("alg2-extreme-remaining", StableRegionsOptions { area_reference: AreaReference::Remaining, ..base.clone() }),
+        (
+            "alg2-random",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..base.clone()
+            },
+        ),
+        (
+            "alg2-extreme-remaining",
+            StableRegionsOptions {
+                area_reference: AreaReference::Remaining,
+                ..base.clone()
+            },
+        ),
         ("alg3-extreme", auto.clone()),
-        ("alg3-random", StableRegionsOptions { init: Init::Random, ..auto.clone() }),
-        ("alg3-extreme-linear", StableRegionsOptions { t_search: TSearch::Linear, ..auto.clone() }),
-        ("alg3-random-linear-cold", StableRegionsOptions { init: Init::Random, t_search: TSearch::Linear, warm_start: false, ..auto.clone() }),
+        (
+            "alg3-random",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..auto.clone()
+            },
+        ),
+        (
+            "alg3-extreme-linear",
+            StableRegionsOptions {
+                t_search: TSearch::Linear,
+                ..auto.clone()
+            },
+        ),
+        (
+            "alg3-random-linear-cold",
+            StableRegionsOptions {
+                init: Init::Random,
+                t_search: TSearch::Linear,
+                warm_start: false,
+                ..auto.clone()
+            },
+        ),
     ]
 }
 
@@ -39,22 +74,54 @@ fn main() -> anyhow::Result<()> {
     let mut dir = None;
     let mut cache = PathBuf::from("/tmp/coseg-eval-cache");
     let mut shapes = 4usize;
-    let mut classes = vec!["cat".to_string(), "dog".into(), "horse".into(), "david".into()];
+    let mut classes = vec![
+        "cat".to_string(),
+        "dog".into(),
+        "horse".into(),
+        "david".into(),
+    ];
     let mut which = "all".to_string();
     let mut pipe = ShapePipelineOptions::default();
     let mut i = 0;
     while i < args.len() {
         let next = |i: usize| args.get(i + 1).cloned().unwrap_or_default();
         match args[i].as_str() {
-            "--cache" => { cache = next(i).into(); i += 1; }
-            "--shapes" => { shapes = next(i).parse()?; i += 1; }
-            "--classes" => { classes = next(i).split(',').map(String::from).collect(); i += 1; }
-            "--configs" => { which = next(i); i += 1; }
-            "--bands" => { pipe.bands.bands = next(i).parse()?; i += 1; }
-            "--eigenpairs" => { pipe.spectrum.eigenpairs = next(i).parse()?; i += 1; }
-            "--hks" => { pipe.descriptors.hks_count = next(i).parse()?; i += 1; }
-            "--wks" => { pipe.descriptors.wks_count = next(i).parse()?; i += 1; }
-            "--curvature" => { pipe.descriptors.curvature_count = next(i).parse()?; i += 1; }
+            "--cache" => {
+                cache = next(i).into();
+                i += 1;
+            }
+            "--shapes" => {
+                shapes = next(i).parse()?;
+                i += 1;
+            }
+            "--classes" => {
+                classes = next(i).split(',').map(String::from).collect();
+                i += 1;
+            }
+            "--configs" => {
+                which = next(i);
+                i += 1;
+            }
+            "--bands" => {
+                pipe.bands.bands = next(i).parse()?;
+                i += 1;
+            }
+            "--eigenpairs" => {
+                pipe.spectrum.eigenpairs = next(i).parse()?;
+                i += 1;
+            }
+            "--hks" => {
+                pipe.descriptors.hks_count = next(i).parse()?;
+                i += 1;
+            }
+            "--wks" => {
+                pipe.descriptors.wks_count = next(i).parse()?;
+                i += 1;
+            }
+            "--curvature" => {
+                pipe.descriptors.curvature_count = next(i).parse()?;
+                i += 1;
+            }
             "--area-bands" => pipe.bands.weighting = BandWeighting::Area,
             d => dir = Some(PathBuf::from(d)),
         }
@@ -74,7 +141,10 @@ fn main() -> anyhow::Result<()> {
             .filter_map(|e| e.ok())
             .filter_map(|e| {
                 let n = e.file_name().to_string_lossy().into_owned();
-                n.strip_prefix(class.as_str())?.strip_suffix(".off")?.parse().ok()
+                n.strip_prefix(class.as_str())?
+                    .strip_suffix(".off")?
+                    .parse()
+                    .ok()
             })
             .collect();
         idx.sort_unstable();
@@ -85,7 +155,13 @@ fn main() -> anyhow::Result<()> {
             let mesh = read_mesh(&path)?;
             let t = Instant::now();
             let d = load_or_compute(&mesh, &pipe, &cache)?;
-            eprintln!("{}: {} vertices, data in {:.1} s ({:?})", path.display(), mesh.vertex_count(), t.elapsed().as_secs_f64(), d.outcome);
+            eprintln!(
+                "{}: {} vertices, data in {:.1} s ({:?})",
+                path.display(),
+                mesh.vertex_count(),
+                t.elapsed().as_secs_f64(),
+                d.outcome
+            );
             data.push((format!("{class}{k}"), mesh.vertex_areas(), d.data.bands));
         }
         for a in 0..data.len() {
@@ -113,10 +189,17 @@ fn main() -> anyhow::Result<()> {
         print!("{name:<26}");
         let mut all = Vec::new();
         for r in &results[k] {
-            print!(" {:>7.2}", 100.0 * r.iter().sum::<f64>() / r.len().max(1) as f64);
+            print!(
+                " {:>7.2}",
+                100.0 * r.iter().sum::<f64>() / r.len().max(1) as f64
+            );
             all.extend(r);
         }
-        println!(" {:>7.2} {:>8.2}", 100.0 * all.iter().sum::<f64>() / all.len().max(1) as f64, times[k]);
+        println!(
+            " {:>7.2} {:>8.2}",
+            100.0 * all.iter().sum::<f64>() / all.len().max(1) as f64,
+            times[k]
+        );
     }
     Ok(())
 }

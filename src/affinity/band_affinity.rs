@@ -112,6 +112,30 @@ fn pair_labels(t: &BandTable) -> Vec<u16> {
     out
 }
 
+/// Per-feature band counts of a 0/1 indicator on one shape, kept up to date incrementally by
+/// [`BandAffinity::update_histogram`] (integer counts: exact).
+#[derive(Debug, Clone)]
+pub struct IndicatorHistogram {
+    dir: Direction,
+    vertices: usize,
+    counts: Vec<u32>,
+    support: Vec<u32>,
+    added: Vec<u32>,
+    removed: Vec<u32>,
+}
+
+impl IndicatorHistogram {
+    /// The current indicator's vertices, ascending.
+    pub fn support(&self) -> &[u32] {
+        &self.support
+    }
+
+    /// The direction the indicator travels.
+    pub fn direction(&self) -> Direction {
+        self.dir
+    }
+}
+
 /// Reusable buffers of a [`BandAffinity`]: products allocate nothing once it exists.
 #[derive(Debug, Clone, Default)]
 pub struct AffinityWorkspace {
@@ -409,10 +433,132 @@ impl<'a> BandAffinity<'a> {
         }
         self.check_rows(dst, rows, out.len())?;
         ws.ensure(self.a.features.max(self.b.features), self.bands);
+        scatter_count(src, self.bands, support, &mut ws.hist_u);
+        self.gather_counts(dir, rows, out, ws);
+        Ok(())
+    }
+
+    /// A histogram of an empty indicator on the source shape of `dir`, for
+    /// [`BandAffinity::update_histogram`] and [`BandAffinity::transport_histogram`].
+    pub fn histogram(&self, dir: Direction) -> IndicatorHistogram {
+        let (src, _) = self.tables(dir);
+        IndicatorHistogram {
+            dir,
+            vertices: src.vertices,
+            counts: vec![0; src.features * self.bands],
+            support: Vec::new(),
+            added: Vec::new(),
+            removed: Vec::new(),
+        }
+    }
+
+    /// Sets the indicator of `hist` to `support` (ascending, on the source shape of its
+    /// direction), updating the per-feature band counts by the symmetric difference with the
+    /// previous support when that is smaller than `support` (counts are integers: the result is
+    /// exactly a fresh histogram's), else recounting in parallel.
+    pub fn update_histogram(
+        &self,
+        hist: &mut IndicatorHistogram,
+        support: &[u32],
+        ws: &mut AffinityWorkspace,
+    ) -> Result<(), AffinityError> {
+        let (src, _) = self.tables(hist.dir);
+        if hist.vertices != src.vertices || hist.counts.len() != src.features * self.bands {
+            return Err(AffinityError::LengthMismatch {
+                expected: src.features * self.bands,
+                got: hist.counts.len(),
+            });
+        }
+        if !support.windows(2).all(|w| w[0] < w[1]) {
+            return Err(AffinityError::Empty(
+                "histogram support must be strictly ascending".into(),
+            ));
+        }
+        if let Some(&bad) = support.last().filter(|&&p| p as usize >= src.vertices) {
+            return Err(AffinityError::IndexOutOfRange {
+                index: bad as usize,
+                vertices: src.vertices,
+            });
+        }
+        // Symmetric difference of two ascending lists.
+        let (old, new) = (&hist.support, support);
+        hist.added.clear();
+        hist.removed.clear();
+        let (mut i, mut j) = (0, 0);
+        while i < old.len() || j < new.len() {
+            if j == new.len() || (i < old.len() && old[i] < new[j]) {
+                hist.removed.push(old[i]);
+                i += 1;
+            } else if i == old.len() || new[j] < old[i] {
+                hist.added.push(new[j]);
+                j += 1;
+            } else {
+                i += 1;
+                j += 1;
+            }
+        }
+        let k = self.bands;
+        if hist.added.len() + hist.removed.len() < support.len() {
+            let c = &mut hist.counts;
+            for (list, inc) in [(&hist.added, 1u32), (&hist.removed, u32::MAX)] {
+                for &p in list.iter() {
+                    let row = src.row(p as usize);
+                    // SAFETY: labels < K (validated at construction), so every index
+                    // `f * K + row[f]` is below `N K = c.len()`.
+                    unsafe {
+                        for (f, &l) in row.iter().enumerate() {
+                            let x = c.get_unchecked_mut(f * k + l as usize);
+                            *x = x.wrapping_add(inc);
+                        }
+                    }
+                }
+            }
+        } else {
+            ws.ensure(self.a.features.max(self.b.features), k);
+            scatter_count(src, k, support, &mut ws.hist_u);
+            let len = hist.counts.len();
+            hist.counts.copy_from_slice(&ws.hist_u[..len]);
+        }
+        hist.support.clear();
+        hist.support.extend_from_slice(support);
+        Ok(())
+    }
+
+    /// Raw scores of the histogram's indicator, as [`BandAffinity::transport_indicator`] gives
+    /// for its support.
+    pub fn transport_histogram(
+        &self,
+        hist: &IndicatorHistogram,
+        rows: Option<&[u32]>,
+        out: &mut [f64],
+        ws: &mut AffinityWorkspace,
+    ) -> Result<(), AffinityError> {
+        let (src, dst) = self.tables(hist.dir);
+        if hist.counts.len() != src.features * self.bands {
+            return Err(AffinityError::LengthMismatch {
+                expected: src.features * self.bands,
+                got: hist.counts.len(),
+            });
+        }
+        self.check_rows(dst, rows, out.len())?;
+        ws.ensure(self.a.features.max(self.b.features), self.bands);
+        ws.hist_u[..hist.counts.len()].copy_from_slice(&hist.counts);
+        self.gather_counts(hist.dir, rows, out, ws);
+        Ok(())
+    }
+
+    /// Scores from the band counts in `ws.hist_u[..N_src K]`.
+    fn gather_counts(
+        &self,
+        dir: Direction,
+        rows: Option<&[u32]>,
+        out: &mut [f64],
+        ws: &mut AffinityWorkspace,
+    ) {
+        let (src, dst) = self.tables(dir);
         let nk = dst.features * self.bands;
+        let k = self.bands;
         if self.raw_weights.is_none() {
-            scatter_count(src, self.bands, support, &mut ws.hist_u);
-            let k = self.bands;
             if !self.identity {
                 let table = &mut ws.table_u[..nk];
                 table.fill(0);
@@ -440,16 +586,14 @@ impl<'a> BandAffinity<'a> {
                 None => gather(dst, k, table, rows, out, |s| s),
             }
         } else {
-            // Weighted pairing: histogram of the 0/1 vector in f64 (exact counts), then mix.
-            scatter_count(src, self.bands, support, &mut ws.hist_u);
-            let len = src.features * self.bands;
+            // Weighted pairing: the 0/1 histogram in f64 (exact counts), then mix.
+            let len = src.features * k;
             for (f, &u) in ws.hist_f[..len].iter_mut().zip(&ws.hist_u[..len]) {
                 *f = u as f64;
             }
             self.mix_f64(dir, ws);
-            gather(dst, self.bands, &ws.table_f[..nk], rows, out, |s| s);
+            gather(dst, k, &ws.table_f[..nk], rows, out, |s| s);
         }
-        Ok(())
     }
 
     fn check_rows(
