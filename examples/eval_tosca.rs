@@ -14,7 +14,7 @@ use coseg::bands::BandWeighting;
 use coseg::cache::{ShapePipelineOptions, load_or_compute};
 use coseg::mesh::read_mesh;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, StableRegionsOptions, TSearch, VertexMap, correspondence_ratio,
+    Algorithm, AreaReference, Init, StableRegionsOptions, TSearch, VertexMap, correspondence_stats,
     stable_regions,
 };
 use std::path::PathBuf;
@@ -136,6 +136,8 @@ fn main() -> anyhow::Result<()> {
     // Per class: the first `shapes` indices present.
     let mut results = vec![vec![Vec::new(); classes.len()]; configs.len()];
     let mut times = vec![0.0; configs.len()];
+    let mut stable_only = vec![Vec::new(); configs.len()];
+    let mut coverage = vec![Vec::new(); configs.len()];
     for (ci, class) in classes.iter().enumerate() {
         let mut idx: Vec<u32> = std::fs::read_dir(&dir)?
             .filter_map(|e| e.ok())
@@ -171,20 +173,28 @@ fn main() -> anyhow::Result<()> {
                     let t = Instant::now();
                     let r = stable_regions(&data[a].2, &data[b].2, &data[a].1, &data[b].1, opts)?;
                     times[k] += t.elapsed().as_secs_f64();
-                    let ratio = correspondence_ratio(&r, &VertexMap::Identity)?;
-                    results[k][ci].push(ratio);
-                    line += &format!(" {:>6.2}", 100.0 * ratio);
+                    let st = correspondence_stats(&r, &VertexMap::Identity)?;
+                    results[k][ci].push(st.ratio);
+                    stable_only[k].push(st.ratio_without_leftover);
+                    coverage[k].push(st.coverage);
+                    line += &format!(" {:>6.2}", 100.0 * st.ratio);
                 }
                 println!("{line}");
             }
         }
     }
-    println!("\nmean correspondence ratio (%) per class, identity ground truth:");
+    println!(
+        "\nmean correspondence ratio (%) per class, identity ground truth; then the ratio over"
+    );
+    println!("non-leftover regions only and their coverage (% of vertices):");
     print!("{:<26}", "config");
     for c in &classes {
         print!(" {c:>7}");
     }
-    println!(" {:>7} {:>8}", "mean", "time s");
+    println!(
+        " {:>7} {:>8} {:>14} {:>9}",
+        "mean", "time s", "w/o leftover", "coverage"
+    );
     for (k, (name, _)) in configs.iter().enumerate() {
         print!("{name:<26}");
         let mut all = Vec::new();

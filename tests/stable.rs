@@ -583,3 +583,32 @@ fn fast_thresholds_match_full_sort_with_many_ties() {
         }
     }
 }
+
+#[test]
+fn correspondence_stats_separate_the_leftover_pair() {
+    use coseg::stable::{RegionPair, correspondence_stats};
+    let pair = |a: Vec<u32>, b: Vec<u32>, leftover| RegionPair {
+        region_a: a,
+        region_b: b,
+        area_fraction_a: 0.0,
+        area_fraction_b: 0.0,
+        objective: 0.0,
+        iterations: 1,
+        converged: true,
+        leftover,
+        auto: None,
+    };
+    // Region 0: {0,1} ↔ {0,2} (vertex 0 matches, 1 does not); leftover {2..5} ↔ {1,3,4,5}.
+    let r = StableRegions {
+        vertices_a: 6,
+        vertices_b: 6,
+        pairs: vec![
+            pair(vec![0, 1], vec![0, 2], false),
+            pair(vec![2, 3, 4, 5], vec![1, 3, 4, 5], true),
+        ],
+    };
+    let s = correspondence_stats(&r, &VertexMap::Identity).unwrap();
+    assert_eq!(s.ratio, 4.0 / 6.0); // 0, 3, 4, 5
+    assert_eq!(s.ratio_without_leftover, 0.5);
+    assert_eq!(s.coverage, 2.0 / 6.0);
+}

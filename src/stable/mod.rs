@@ -16,7 +16,9 @@ mod stable_pairs_fixed;
 mod stable_regions;
 mod threshold;
 
-pub use correspondence_ratio::{VertexMap, correspondence_ratio};
+pub use correspondence_ratio::{
+    CorrespondenceStats, VertexMap, correspondence_ratio, correspondence_stats,
+};
 pub use initial_indicator::{Init, initial_indicator};
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
