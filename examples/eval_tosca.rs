@@ -205,10 +205,13 @@ fn main() -> anyhow::Result<()> {
             );
             all.extend(r);
         }
+        let mean = |v: &[f64]| 100.0 * v.iter().sum::<f64>() / v.len().max(1) as f64;
         println!(
-            " {:>7.2} {:>8.2}",
-            100.0 * all.iter().sum::<f64>() / all.len().max(1) as f64,
-            times[k]
+            " {:>7.2} {:>8.2} {:>14.2} {:>9.2}",
+            mean(&all),
+            times[k],
+            mean(&stable_only[k]),
+            mean(&coverage[k])
         );
     }
     Ok(())
