@@ -21,7 +21,11 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 fn configs() -> Vec<(&'static str, StableRegionsOptions)> {
-    let base = StableRegionsOptions::default();
+    // Explicit inits: the configurations do not depend on the library's default.
+    let base = StableRegionsOptions {
+        init: Init::Extreme,
+        ..Default::default()
+    };
     let auto = StableRegionsOptions {
         algorithm: Algorithm::Auto,
         ..base.clone()

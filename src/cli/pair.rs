@@ -64,7 +64,7 @@ pub struct PairArgs {
     #[arg(long)]
     linear_t: bool,
     /// Initial indicators.
-    #[arg(long, value_enum, default_value = "extreme")]
+    #[arg(long, value_enum, default_value = "random")]
     init: InitArg,
     /// Seed of the random initial indicators.
     #[arg(long, default_value_t = 0)]
