@@ -257,3 +257,29 @@ fn rejects_bad_input() {
         Err(AffinityError::BadWeights(_))
     ));
 }
+
+#[test]
+fn incremental_histograms_equal_fresh_products() {
+    let a = random_table(3000, 17, 9, 41);
+    let b = random_table(2500, 17, 9, 42);
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let mut ws = w.workspace();
+    let mut h = w.histogram(Direction::BtoA);
+    let rows: Vec<u32> = (0..3000).filter(|v| v % 3 != 0).collect();
+    let (mut got, mut want) = (vec![0.0; rows.len()], vec![0.0; rows.len()]);
+    for step in 0..8u64 {
+        // Supports of varying overlap: small deltas, then complete changes.
+        let x = random_vec(2500, step / 2);
+        let cut = if step % 2 == 0 { 0.3 } else { 0.31 };
+        let support: Vec<u32> = (0..2500).filter(|&q| x[q as usize] < cut).collect();
+        w.update_histogram(&mut h, &support, &mut ws).unwrap();
+        assert_eq!(h.support(), &support[..]);
+        w.transport_histogram(&h, Some(&rows), &mut got, &mut ws)
+            .unwrap();
+        w.transport_indicator(Direction::BtoA, &support, Some(&rows), &mut want, &mut ws)
+            .unwrap();
+        assert_eq!(got, want, "step {step}");
+    }
+    assert!(w.update_histogram(&mut h, &[3, 2], &mut ws).is_err());
+    assert!(w.update_histogram(&mut h, &[2500], &mut ws).is_err());
+}

@@ -4,7 +4,9 @@ mod common;
 
 use common::stable::{noisy_copy, random_table, random_vec};
 use coseg::affinity::{BandAffinity, dense_affinity};
-use coseg::stable::{Remaining, StablePairOptions, Threshold, stable_pair, threshold};
+use coseg::stable::{
+    Remaining, StablePairOptions, Threshold, ThresholdScratch, stable_pair, threshold,
+};
 
 fn all(n: usize) -> Vec<u32> {
     (0..n as u32).collect()
@@ -25,7 +27,7 @@ fn dense_objective(d: &[f64], cols: usize, f: &[u32], g: &[u32]) -> f64 {
 fn count_threshold_breaks_ties_by_index() {
     let v = [1, 3, 4, 8, 9];
     let s = [2.0, 5.0, 2.0, 2.0, 5.0];
-    let (mut out, mut sc) = (Vec::new(), Vec::new());
+    let (mut out, mut sc) = (Vec::new(), ThresholdScratch::default());
     let areas = vec![1.0; 10];
     threshold(Threshold::Count(3), &v, &s, &areas, 5.0, &mut out, &mut sc);
     assert_eq!(out, vec![1, 3, 9]);
@@ -42,7 +44,7 @@ fn area_threshold_stops_at_first_prefix_reaching_alpha() {
     let v = [0, 1, 2, 3];
     let s = [4.0, 3.0, 3.0, 1.0];
     let areas = [1.0, 2.0, 0.5, 1.5];
-    let (mut out, mut sc) = (Vec::new(), Vec::new());
+    let (mut out, mut sc) = (Vec::new(), ThresholdScratch::default());
     // Order: 0 (1.0), 1 (3.0), 2 (3.5), 3 (5.0). α·5 = 3 → {0, 1}.
     threshold(
         Threshold::AreaFraction(0.6),
@@ -90,7 +92,7 @@ fn area_threshold_stops_at_first_prefix_reaching_alpha() {
 fn mean_std_threshold() {
     let v = [0, 1, 2, 3];
     let s = [1.0, 2.0, 3.0, 4.0]; // μ = 2.5, σ = √1.25
-    let (mut out, mut sc) = (Vec::new(), Vec::new());
+    let (mut out, mut sc) = (Vec::new(), ThresholdScratch::default());
     let areas = [1.0; 4];
     threshold(
         Threshold::MeanStd(0.0),
@@ -507,4 +509,106 @@ fn options_are_validated() {
         )
         .is_err()
     );
+}
+
+/// Reference thresholds by a full sort (score descending, position ascending).
+fn naive_threshold(
+    rule: Threshold,
+    v: &[u32],
+    s: &[f64],
+    areas: &[f64],
+    reference: f64,
+) -> Vec<u32> {
+    let mut order: Vec<usize> = (0..v.len()).collect();
+    order.sort_by(|&i, &j| s[j].total_cmp(&s[i]).then(i.cmp(&j)));
+    let mut out: Vec<u32> = match rule {
+        Threshold::Count(p) => order.iter().take(p).map(|&i| v[i]).collect(),
+        Threshold::AreaFraction(a) => {
+            let mut acc = 0.0;
+            let mut o = Vec::new();
+            for &i in &order {
+                if acc >= a * reference {
+                    break;
+                }
+                o.push(v[i]);
+                acc += areas[v[i] as usize];
+            }
+            o
+        }
+        Threshold::MeanStd(_) => unreachable!(),
+    };
+    out.sort_unstable();
+    out
+}
+
+#[test]
+fn fast_thresholds_match_full_sort_with_many_ties() {
+    let mut scratch = ThresholdScratch::default();
+    let mut out = Vec::new();
+    for seed in 0..12u64 {
+        let n = 3000;
+        let x = random_vec(n, seed);
+        // Integer scores with heavy ties, some negative.
+        let s: Vec<f64> = x.iter().map(|u| (u * 40.0).floor() - 10.0).collect();
+        let v: Vec<u32> = (0..n as u32).map(|i| 2 * i + (seed as u32 % 2)).collect();
+        let ar = random_vec(2 * n + 1, seed + 50);
+        // Uneven areas: a few huge vertices in some seeds defeat the candidate guess.
+        let areas: Vec<f64> = ar
+            .iter()
+            .enumerate()
+            .map(|(i, a)| {
+                if seed % 3 == 0 && i % 97 == 0 {
+                    200.0 * a
+                } else {
+                    *a
+                }
+            })
+            .collect();
+        let reference: f64 = v.iter().map(|&i| areas[i as usize]).sum();
+        for rule in [
+            Threshold::Count(1),
+            Threshold::Count(77),
+            Threshold::Count(2999),
+            Threshold::AreaFraction(0.01),
+            Threshold::AreaFraction(0.1),
+            Threshold::AreaFraction(0.5),
+            Threshold::AreaFraction(0.97),
+        ] {
+            threshold(rule, &v, &s, &areas, reference, &mut out, &mut scratch);
+            assert_eq!(
+                out,
+                naive_threshold(rule, &v, &s, &areas, reference),
+                "{rule:?} seed {seed}"
+            );
+        }
+    }
+}
+
+#[test]
+fn correspondence_stats_separate_the_leftover_pair() {
+    use coseg::stable::{RegionPair, correspondence_stats};
+    let pair = |a: Vec<u32>, b: Vec<u32>, leftover| RegionPair {
+        region_a: a,
+        region_b: b,
+        area_fraction_a: 0.0,
+        area_fraction_b: 0.0,
+        objective: 0.0,
+        iterations: 1,
+        converged: true,
+        leftover,
+        auto: None,
+    };
+    // Region 0: {0,1} ↔ {0,2} (vertex 0 matches, 1 does not); leftover {2..5} ↔ {1,3,4,5}.
+    let r = StableRegions {
+        vertices_a: 6,
+        vertices_b: 6,
+        pairs: vec![
+            pair(vec![0, 1], vec![0, 2], false),
+            pair(vec![2, 3, 4, 5], vec![1, 3, 4, 5], true),
+        ],
+    };
+    let s = correspondence_stats(&r, &VertexMap::Identity).unwrap();
+    assert_eq!(s.ratio, 4.0 / 6.0); // 0, 3, 4, 5
+    assert_eq!(s.ratio_without_leftover, 0.5);
+    assert_eq!(s.coverage, 2.0 / 6.0);
 }

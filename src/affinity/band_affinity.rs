@@ -83,6 +83,57 @@ pub struct BandAffinity<'a> {
     /// Identity pairing with the same feature count on both sides.
     identity: bool,
     unit: f64,
+    /// Pair labels `l_{2i} K + l_{2i+1}` of A and B (vertex-major, `ceil(N/2)` per vertex) when
+    /// `K ≤ PAIR_MAX_BANDS`: the integer gather then reads one `u16` and one table entry per two
+    /// features.
+    pair_labels: Option<(Vec<u16>, Vec<u16>)>,
+}
+
+/// Largest `K` for which the paired gather is used (its table has `ceil(N/2) K²` entries).
+const PAIR_MAX_BANDS: usize = 32;
+
+/// Pair labels of a table: `out[v * P + i] = l(v, 2i) K + l(v, 2i + 1)` (`0` past the last
+/// feature).
+fn pair_labels(t: &BandTable) -> Vec<u16> {
+    let (nf, k) = (t.features, t.bands);
+    let np = nf.div_ceil(2);
+    let mut out = vec![0u16; t.vertices * np];
+    out.par_chunks_mut(np * 1024)
+        .zip(t.labels.par_chunks(nf * 1024))
+        .for_each(|(o, l)| {
+            for (orow, lrow) in o.chunks_exact_mut(np).zip(l.chunks_exact(nf)) {
+                for (i, x) in orow.iter_mut().enumerate() {
+                    let l0 = lrow[2 * i] as u16;
+                    let l1 = lrow.get(2 * i + 1).map_or(0, |&v| v as u16);
+                    *x = l0 * k as u16 + l1;
+                }
+            }
+        });
+    out
+}
+
+/// Per-feature band counts of a 0/1 indicator on one shape, kept up to date incrementally by
+/// [`BandAffinity::update_histogram`] (integer counts: exact).
+#[derive(Debug, Clone)]
+pub struct IndicatorHistogram {
+    dir: Direction,
+    vertices: usize,
+    counts: Vec<u32>,
+    support: Vec<u32>,
+    added: Vec<u32>,
+    removed: Vec<u32>,
+}
+
+impl IndicatorHistogram {
+    /// The current indicator's vertices, ascending.
+    pub fn support(&self) -> &[u32] {
+        &self.support
+    }
+
+    /// The direction the indicator travels.
+    pub fn direction(&self) -> Direction {
+        self.dir
+    }
 }
 
 /// Reusable buffers of a [`BandAffinity`]: products allocate nothing once it exists.
@@ -92,6 +143,7 @@ pub struct AffinityWorkspace {
     hist_f: Vec<f64>,
     table_u: Vec<u32>,
     table_f: Vec<f64>,
+    table_pair: Vec<u32>,
     support: Vec<u32>,
 }
 
@@ -103,6 +155,10 @@ impl AffinityWorkspace {
             self.hist_f.resize(SCATTER_CHUNKS * len, 0.0);
             self.table_u.resize(len, 0);
             self.table_f.resize(len, 0.0);
+            if bands <= PAIR_MAX_BANDS {
+                self.table_pair
+                    .resize(features.div_ceil(2) * bands * bands, 0);
+            }
         }
     }
 }
@@ -212,6 +268,8 @@ impl<'a> BandAffinity<'a> {
                 .enumerate()
                 .all(|(i, &(x, y))| x as usize == i && y as usize == i);
         let unit = a.bands as f64 / (n as f64 * a.vertices as f64 * b.vertices as f64);
+        let pair_labels = (raw_weights.is_none() && a.bands <= PAIR_MAX_BANDS)
+            .then(|| (pair_labels(a), pair_labels(b)));
         Ok(Self {
             a,
             b,
@@ -220,7 +278,15 @@ impl<'a> BandAffinity<'a> {
             raw_weights,
             identity,
             unit,
+            pair_labels,
         })
+    }
+
+    /// Disables the paired gather (benchmarks compare both; results are identical).
+    #[doc(hidden)]
+    pub fn without_pair_gather(mut self) -> Self {
+        self.pair_labels = None;
+        self
     }
 
     /// `d_b`, the number of rows of `W`.
@@ -367,15 +433,135 @@ impl<'a> BandAffinity<'a> {
         }
         self.check_rows(dst, rows, out.len())?;
         ws.ensure(self.a.features.max(self.b.features), self.bands);
-        let nk = dst.features * self.bands;
-        if self.raw_weights.is_none() {
-            scatter_count(src, self.bands, support, &mut ws.hist_u);
-            if self.identity {
-                gather(dst, self.bands, &ws.hist_u[..nk], rows, out, |s| s);
+        scatter_count(src, self.bands, support, &mut ws.hist_u);
+        self.gather_counts(dir, rows, out, ws);
+        Ok(())
+    }
+
+    /// A histogram of an empty indicator on the source shape of `dir`, for
+    /// [`BandAffinity::update_histogram`] and [`BandAffinity::transport_histogram`].
+    pub fn histogram(&self, dir: Direction) -> IndicatorHistogram {
+        let (src, _) = self.tables(dir);
+        IndicatorHistogram {
+            dir,
+            vertices: src.vertices,
+            counts: vec![0; src.features * self.bands],
+            support: Vec::new(),
+            added: Vec::new(),
+            removed: Vec::new(),
+        }
+    }
+
+    /// Sets the indicator of `hist` to `support` (ascending, on the source shape of its
+    /// direction), updating the per-feature band counts by the symmetric difference with the
+    /// previous support when that is smaller than `support` (counts are integers: the result is
+    /// exactly a fresh histogram's), else recounting in parallel.
+    pub fn update_histogram(
+        &self,
+        hist: &mut IndicatorHistogram,
+        support: &[u32],
+        ws: &mut AffinityWorkspace,
+    ) -> Result<(), AffinityError> {
+        let (src, _) = self.tables(hist.dir);
+        if hist.vertices != src.vertices || hist.counts.len() != src.features * self.bands {
+            return Err(AffinityError::LengthMismatch {
+                expected: src.features * self.bands,
+                got: hist.counts.len(),
+            });
+        }
+        if !support.windows(2).all(|w| w[0] < w[1]) {
+            return Err(AffinityError::Empty(
+                "histogram support must be strictly ascending".into(),
+            ));
+        }
+        if let Some(&bad) = support.last().filter(|&&p| p as usize >= src.vertices) {
+            return Err(AffinityError::IndexOutOfRange {
+                index: bad as usize,
+                vertices: src.vertices,
+            });
+        }
+        // Symmetric difference of two ascending lists.
+        let (old, new) = (&hist.support, support);
+        hist.added.clear();
+        hist.removed.clear();
+        let (mut i, mut j) = (0, 0);
+        while i < old.len() || j < new.len() {
+            if j == new.len() || (i < old.len() && old[i] < new[j]) {
+                hist.removed.push(old[i]);
+                i += 1;
+            } else if i == old.len() || new[j] < old[i] {
+                hist.added.push(new[j]);
+                j += 1;
             } else {
+                i += 1;
+                j += 1;
+            }
+        }
+        let k = self.bands;
+        if hist.added.len() + hist.removed.len() < support.len() {
+            let c = &mut hist.counts;
+            for (list, inc) in [(&hist.added, 1u32), (&hist.removed, u32::MAX)] {
+                for &p in list.iter() {
+                    let row = src.row(p as usize);
+                    // SAFETY: labels < K (validated at construction), so every index
+                    // `f * K + row[f]` is below `N K = c.len()`.
+                    unsafe {
+                        for (f, &l) in row.iter().enumerate() {
+                            let x = c.get_unchecked_mut(f * k + l as usize);
+                            *x = x.wrapping_add(inc);
+                        }
+                    }
+                }
+            }
+        } else {
+            ws.ensure(self.a.features.max(self.b.features), k);
+            scatter_count(src, k, support, &mut ws.hist_u);
+            let len = hist.counts.len();
+            hist.counts.copy_from_slice(&ws.hist_u[..len]);
+        }
+        hist.support.clear();
+        hist.support.extend_from_slice(support);
+        Ok(())
+    }
+
+    /// Raw scores of the histogram's indicator, as [`BandAffinity::transport_indicator`] gives
+    /// for its support.
+    pub fn transport_histogram(
+        &self,
+        hist: &IndicatorHistogram,
+        rows: Option<&[u32]>,
+        out: &mut [f64],
+        ws: &mut AffinityWorkspace,
+    ) -> Result<(), AffinityError> {
+        let (src, dst) = self.tables(hist.dir);
+        if hist.counts.len() != src.features * self.bands {
+            return Err(AffinityError::LengthMismatch {
+                expected: src.features * self.bands,
+                got: hist.counts.len(),
+            });
+        }
+        self.check_rows(dst, rows, out.len())?;
+        ws.ensure(self.a.features.max(self.b.features), self.bands);
+        ws.hist_u[..hist.counts.len()].copy_from_slice(&hist.counts);
+        self.gather_counts(hist.dir, rows, out, ws);
+        Ok(())
+    }
+
+    /// Scores from the band counts in `ws.hist_u[..N_src K]`.
+    fn gather_counts(
+        &self,
+        dir: Direction,
+        rows: Option<&[u32]>,
+        out: &mut [f64],
+        ws: &mut AffinityWorkspace,
+    ) {
+        let (src, dst) = self.tables(dir);
+        let nk = dst.features * self.bands;
+        let k = self.bands;
+        if self.raw_weights.is_none() {
+            if !self.identity {
                 let table = &mut ws.table_u[..nk];
                 table.fill(0);
-                let k = self.bands;
                 for &(ka, kb) in &self.pairs {
                     let (s, d) = pick(dir, ka, kb);
                     let h = &ws.hist_u[s * k..(s + 1) * k];
@@ -383,19 +569,31 @@ impl<'a> BandAffinity<'a> {
                         *t += c;
                     }
                 }
-                gather(dst, self.bands, table, rows, out, |s| s);
+            }
+            let table: &[u32] = if self.identity {
+                &ws.hist_u[..nk]
+            } else {
+                &ws.table_u[..nk]
+            };
+            match &self.pair_labels {
+                Some((pa, pb)) => {
+                    let labels = if dir == Direction::AtoB { pb } else { pa };
+                    let np = dst.features.div_ceil(2);
+                    let t2 = &mut ws.table_pair[..np * k * k];
+                    build_pair_table(table, dst.features, k, t2);
+                    gather_pairs(labels, np, k * k, t2, rows, out);
+                }
+                None => gather(dst, k, table, rows, out, |s| s),
             }
         } else {
-            // Weighted pairing: histogram of the 0/1 vector in f64 (exact counts), then mix.
-            scatter_count(src, self.bands, support, &mut ws.hist_u);
-            let len = src.features * self.bands;
+            // Weighted pairing: the 0/1 histogram in f64 (exact counts), then mix.
+            let len = src.features * k;
             for (f, &u) in ws.hist_f[..len].iter_mut().zip(&ws.hist_u[..len]) {
                 *f = u as f64;
             }
             self.mix_f64(dir, ws);
-            gather(dst, self.bands, &ws.table_f[..nk], rows, out, |s| s);
+            gather(dst, k, &ws.table_f[..nk], rows, out, |s| s);
         }
-        Ok(())
     }
 
     fn check_rows(
@@ -609,6 +807,82 @@ fn gather<T: Bin>(
                 .for_each(|(o, idx)| {
                     for (v, &q) in o.iter_mut().zip(idx) {
                         *v = post(row_sum(table, dst.row(q as usize), bands));
+                    }
+                });
+        }
+    }
+}
+
+/// `t2[i K² + l K + m] = table[2i K + l] + table[(2i + 1) K + m]` (second term `0` past the last
+/// feature).
+fn build_pair_table(table: &[u32], features: usize, k: usize, t2: &mut [u32]) {
+    for (i, blk) in t2.chunks_exact_mut(k * k).enumerate() {
+        let h0 = &table[2 * i * k..(2 * i + 1) * k];
+        let h1 = table
+            .get((2 * i + 1) * k..(2 * i + 2) * k)
+            .filter(|_| 2 * i + 1 < features);
+        for (l, row) in blk.chunks_exact_mut(k).enumerate() {
+            match h1 {
+                Some(h1) => {
+                    for (x, &m) in row.iter_mut().zip(h1) {
+                        *x = h0[l] + m;
+                    }
+                }
+                None => row.fill(h0[l]),
+            }
+        }
+    }
+}
+
+/// Sum of `t2[i K² + pl[i]]` with four accumulators.
+#[inline(always)]
+fn pair_row_sum(t2: &[u32], pl: &[u16], kk: usize) -> f64 {
+    debug_assert_eq!(t2.len(), pl.len() * kk);
+    let mut acc = [0u64; 4];
+    let quads = pl.len() / 4;
+    // SAFETY: pair labels are built as `l0 K + l1` from labels `< K` (validated at construction),
+    // so `pl[i] < K² = kk` and `i kk + pl[i] < pl.len() kk = t2.len()`.
+    unsafe {
+        for q in 0..quads {
+            let i = 4 * q;
+            for (j, a) in acc.iter_mut().enumerate() {
+                let ii = i + j;
+                *a += *t2.get_unchecked(ii * kk + *pl.get_unchecked(ii) as usize) as u64;
+            }
+        }
+        for ii in 4 * quads..pl.len() {
+            acc[0] += *t2.get_unchecked(ii * kk + *pl.get_unchecked(ii) as usize) as u64;
+        }
+    }
+    ((acc[0] + acc[1]) + (acc[2] + acc[3])) as f64
+}
+
+/// The paired integer gather (see [`gather`]).
+fn gather_pairs(
+    labels: &[u16],
+    np: usize,
+    kk: usize,
+    t2: &[u32],
+    rows: Option<&[u32]>,
+    out: &mut [f64],
+) {
+    match rows {
+        None => {
+            out.par_chunks_mut(GATHER_BLOCK)
+                .zip(labels.par_chunks(GATHER_BLOCK * np))
+                .for_each(|(o, l)| {
+                    for (v, row) in o.iter_mut().zip(l.chunks_exact(np)) {
+                        *v = pair_row_sum(t2, row, kk);
+                    }
+                });
+        }
+        Some(r) => {
+            out.par_chunks_mut(GATHER_BLOCK)
+                .zip(r.par_chunks(GATHER_BLOCK))
+                .for_each(|(o, idx)| {
+                    for (v, &q) in o.iter_mut().zip(idx) {
+                        let q = q as usize;
+                        *v = pair_row_sum(t2, &labels[q * np..(q + 1) * np], kk);
                     }
                 });
         }

@@ -14,7 +14,9 @@
 mod band_affinity;
 mod dense_affinity;
 
-pub use band_affinity::{AffinityWorkspace, BandAffinity, Direction, FeaturePairing};
+pub use band_affinity::{
+    AffinityWorkspace, BandAffinity, Direction, FeaturePairing, IndicatorHistogram,
+};
 pub use dense_affinity::{DENSE_LIMIT, dense_affinity};
 
 use thiserror::Error;

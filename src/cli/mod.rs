@@ -5,6 +5,7 @@ mod features;
 mod generate;
 mod info;
 mod spectrum;
+mod pair;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -34,6 +35,8 @@ enum Command {
     Features(features::FeaturesArgs),
     /// Generate a synthetic shape family with ground-truth part labels.
     Generate(generate::GenerateArgs),
+    /// Stable region correspondences between two meshes (Algorithm 2 or 3).
+    Pair(pair::PairArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
@@ -44,6 +47,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Convert(args) => convert::run(args),
         Command::Features(args) => features::run(args),
         Command::Generate(args) => generate::run(args),
+        Command::Pair(args) => pair::run(args),
     }
 }
 

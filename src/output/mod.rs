@@ -1,1 +1,56 @@
-//! Placeholder: filled in by its issue.
+//! Output files of a segmentation: per-vertex region ids, coloured meshes and a JSON summary.
+//!
+//! Generic over the stage that produced the regions (two-shape stable regions or a collection):
+//! a shape is a name, its mesh and one region id per vertex (`-1` = none); the summary is any
+//! serialisable value. Every file is written atomically (temporary file + rename), so a crash
+//! never leaves a half-written output.
+//!
+//! - `OUT/<name>.regions.txt`: one integer region id per line, in the input file's vertex order.
+//! - `OUT/<name>.regions.ply`: the mesh with `red`/`green`/`blue` colours by region and an
+//!   integer `region` vertex property.
+//! - `OUT/summary.json`: the summary, pretty-printed.
+
+mod pair_summary;
+mod region_colors;
+mod write_regions;
+
+pub use pair_summary::{PairSummary, RegionSummary, ShapeSummary};
+pub use region_colors::region_colors;
+pub use write_regions::{
+    ShapeRegions, write_region_ids, write_region_mesh, write_regions, write_summary,
+};
+
+use thiserror::Error;
+
+/// Errors of the output stage; each names the file concerned.
+#[derive(Debug, Error)]
+pub enum OutputError {
+    /// Writing a file failed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// Writing a mesh failed.
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    /// The region ids do not match the mesh.
+    #[error("{name}: {ids} region ids for a mesh of {vertices} vertices")]
+    Length {
+        /// Shape name.
+        name: String,
+        /// Number of ids given.
+        ids: usize,
+        /// Vertex count.
+        vertices: usize,
+    },
+    /// A shape name that cannot be a file name.
+    #[error("invalid shape name {0:?}: must be non-empty without path separators")]
+    BadName(String),
+    /// The summary could not be serialised.
+    #[error("summary.json: {0}")]
+    Json(String),
+}

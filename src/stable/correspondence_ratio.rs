@@ -52,13 +52,38 @@ impl VertexMap {
 /// assert_eq!(correspondence_ratio(&r, &VertexMap::Identity).unwrap(), 0.5);
 /// ```
 pub fn correspondence_ratio(regions: &StableRegions, map: &VertexMap) -> Result<f64, StableError> {
+    Ok(correspondence_stats(regions, map)?.ratio)
+}
+
+/// The correspondence ratio with and without the leftover pair.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct CorrespondenceStats {
+    /// [`correspondence_ratio`] over every pair (the paper's measure).
+    pub ratio: f64,
+    /// The same over the vertices of `C_A` in non-leftover regions only (`0` when there are
+    /// none): how well the extracted stable pairs themselves match.
+    pub ratio_without_leftover: f64,
+    /// Fraction of `C_A` in non-leftover regions.
+    pub coverage: f64,
+}
+
+/// [`correspondence_ratio`] plus the ratio restricted to the stable (non-leftover) pairs and
+/// their coverage: a large leftover region matches itself and can dominate the plain ratio.
+pub fn correspondence_stats(
+    regions: &StableRegions,
+    map: &VertexMap,
+) -> Result<CorrespondenceStats, StableError> {
+    let leftover: Vec<bool> = regions.pairs.iter().map(|p| p.leftover).collect();
     let la = regions.labels_a();
     let lb = regions.labels_b();
-    let (mut hit, mut total) = (0usize, 0usize);
+    let (mut hit, mut total, mut hit_s, mut total_s) = (0usize, 0usize, 0usize, 0usize);
     let mut check = |p: usize, q: usize| {
         total += 1;
+        let stable = la[p] >= 0 && !leftover[la[p] as usize];
+        total_s += usize::from(stable);
         if la[p] >= 0 && la[p] == lb[q] {
             hit += 1;
+            hit_s += usize::from(stable);
         }
     };
     match map {
@@ -91,5 +116,13 @@ pub fn correspondence_ratio(regions: &StableRegions, map: &VertexMap) -> Result<
     if total == 0 {
         return Err(StableError::BadMap("no corresponding vertices".into()));
     }
-    Ok(hit as f64 / total as f64)
+    Ok(CorrespondenceStats {
+        ratio: hit as f64 / total as f64,
+        ratio_without_leftover: if total_s == 0 {
+            0.0
+        } else {
+            hit_s as f64 / total_s as f64
+        },
+        coverage: total_s as f64 / total as f64,
+    })
 }

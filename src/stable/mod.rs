@@ -16,7 +16,9 @@ mod stable_pairs_fixed;
 mod stable_regions;
 mod threshold;
 
-pub use correspondence_ratio::{VertexMap, correspondence_ratio};
+pub use correspondence_ratio::{
+    CorrespondenceStats, VertexMap, correspondence_ratio, correspondence_stats,
+};
 pub use initial_indicator::{Init, initial_indicator};
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
@@ -25,9 +27,9 @@ pub use stable_pairs_auto::stable_pairs_auto;
 pub use stable_pairs_fixed::stable_pairs_fixed;
 pub use stable_regions::{
     Algorithm, AreaReference, AutoThreshold, RegionPair, StableRegions, StableRegionsOptions,
-    stable_regions,
+    TSearch, stable_regions,
 };
-pub use threshold::{Threshold, threshold};
+pub use threshold::{Threshold, ThresholdScratch, threshold};
 
 use crate::affinity::AffinityError;
 use thiserror::Error;

@@ -1,7 +1,7 @@
 //! [`stable_pair`]: Algorithm 1, a stable pair of regions from an initial indicator.
 
-use super::{StableError, Threshold, threshold};
-use crate::affinity::{AffinityWorkspace, BandAffinity, Direction};
+use super::{StableError, Threshold, ThresholdScratch, threshold};
+use crate::affinity::{AffinityWorkspace, BandAffinity, Direction, IndicatorHistogram};
 use serde::{Deserialize, Serialize};
 
 /// The remaining vertex subsets of both shapes and the per-vertex areas the rules use.
@@ -72,7 +72,9 @@ pub struct StableWorkspace {
     pub affinity: AffinityWorkspace,
     scores_a: Vec<f64>,
     scores_b: Vec<f64>,
-    scratch: Vec<u32>,
+    scratch: ThresholdScratch,
+    /// Incremental histograms of `f` (A → B) and `g` (B → A).
+    hists: Option<(IndicatorHistogram, IndicatorHistogram)>,
 }
 
 /// Sorted intersection of two ascending lists.
@@ -147,6 +149,19 @@ pub fn stable_pair_with(
     options: &StablePairOptions,
     ws: &mut StableWorkspace,
 ) -> Result<StablePair, StableError> {
+    ws.hists = None;
+    stable_pair_inner(w, remaining, f0, options, ws)
+}
+
+/// [`stable_pair_with`] keeping the workspace's histograms from an earlier call, which must
+/// have used the same operator `w` (Algorithms 2 and 3 hold one operator per extraction).
+pub(crate) fn stable_pair_inner(
+    w: &BandAffinity<'_>,
+    remaining: &Remaining<'_>,
+    f0: &[u32],
+    options: &StablePairOptions,
+    ws: &mut StableWorkspace,
+) -> Result<StablePair, StableError> {
     let (ra, rb) = (remaining.vertices_a, remaining.vertices_b);
     if remaining.areas_a.len() != w.cols() || remaining.areas_b.len() != w.rows() {
         return Err(StableError::AreaLength {
@@ -177,13 +192,11 @@ pub fn stable_pair_with(
     let mut cycled = false;
     while iterations < options.max_iterations {
         iterations += 1;
-        w.transport_indicator(
-            Direction::AtoB,
-            &f,
-            Some(rb),
-            &mut ws.scores_b,
-            &mut ws.affinity,
-        )?;
+        let (hf, _) = ws
+            .hists
+            .get_or_insert_with(|| (w.histogram(Direction::AtoB), w.histogram(Direction::BtoA)));
+        w.update_histogram(hf, &f, &mut ws.affinity)?;
+        w.transport_histogram(hf, Some(rb), &mut ws.scores_b, &mut ws.affinity)?;
         threshold(
             options.p,
             rb,
@@ -194,13 +207,9 @@ pub fn stable_pair_with(
             &mut ws.scratch,
         );
         history.push(unit * selected_sum(rb, &ws.scores_b, &g));
-        w.transport_indicator(
-            Direction::BtoA,
-            &g,
-            Some(ra),
-            &mut ws.scores_a,
-            &mut ws.affinity,
-        )?;
+        let (_, hg) = ws.hists.as_mut().expect("set above");
+        w.update_histogram(hg, &g, &mut ws.affinity)?;
+        w.transport_histogram(hg, Some(ra), &mut ws.scores_a, &mut ws.affinity)?;
         threshold(
             options.q,
             ra,

@@ -1,12 +1,15 @@
 //! [`stable_pairs_auto`]: Algorithm 3, stable pairs with automatic thresholds.
 
 use super::stable_pairs_fixed::Extraction;
-use super::stable_regions::{AutoThreshold, StableRegions, StableRegionsOptions};
-use super::{StableError, StablePairOptions, Threshold, initial_indicator};
+use super::stable_regions::{AutoThreshold, StableRegions, StableRegionsOptions, TSearch};
+use super::{StableError, StablePair, StablePairOptions, Threshold, initial_indicator};
 use crate::affinity::BandAffinity;
 
-/// Algorithm 3: for each of the first `K − 1` pairs, raise `t = 0, δt, 2δt, …` while
-/// Algorithm 1 with `P[τ_t]`, `Q[τ_t]` still returns a non-empty pair (up to `t_max`); with the
+/// Algorithm 3: for each of the first `K − 1` pairs, find the largest `t ∈ {0, δt, 2δt, …}`
+/// (up to `t_max`) for which Algorithm 1 with `P[τ_t]`, `Q[τ_t]` returns a non-empty pair —
+/// stepping up one `δt` at a time as the paper does ([`TSearch::Linear`]) or by galloping and
+/// bisection from the previous pair's `t`, which assumes emptiness is monotone in `t`
+/// ([`TSearch::Bisect`]); with the
 /// last non-empty pair `(Ω^t_A, Ω^t_B)` set `α = max(α_A, α_B)` (fractions of the remaining
 /// areas) and run Algorithm 1 with `P_α`, `Q_α` from `1_{Ω^t_A}`; remove the pair. The
 /// leftovers form the last pair. Stops early when even `t = 0` gives an empty pair.
@@ -34,33 +37,99 @@ pub fn stable_pairs_auto(
     let mut ex = Extraction::new(w, areas_a, areas_b)?;
     let mut pairs = Vec::with_capacity(options.pairs);
     let steps = (options.t_max / options.delta_t).floor().max(0.0) as usize;
+    let mut prev_step = 0usize;
     for i in 0..options.pairs - 1 {
         if ex.rem_a.is_empty() || ex.rem_b.is_empty() {
             break;
         }
         let (rem_area_a, rem_area_b) = (ex.remaining_area_a(), ex.remaining_area_b());
         let f_in = initial_indicator(w, &ex.rem_a, options.init, options.seed, i);
-        let mut start = f_in.clone();
-        let mut last = None;
         let mut search_iterations = 0;
-        for s in 0..=steps {
+        let mut start = f_in.clone();
+        // Runs Algorithm 1 with P[τ_t], Q[τ_t] at step s; `None` when the pair is empty.
+        let mut probe = |s: usize, start: &[u32], ex: &mut Extraction<'_>| {
             let t = s as f64 * options.delta_t;
             let opts = StablePairOptions {
                 p: Threshold::MeanStd(t),
                 q: Threshold::MeanStd(t),
                 max_iterations: options.max_iterations,
             };
-            let pair = ex.run(w, &start, &opts, (rem_area_a, rem_area_b))?;
+            let pair = ex.run(w, start, &opts, (rem_area_a, rem_area_b))?;
             search_iterations += pair.iterations;
-            if pair.region_a.is_empty() || pair.region_b.is_empty() {
-                break;
+            Ok::<_, StableError>(
+                (!pair.region_a.is_empty() && !pair.region_b.is_empty()).then_some((t, pair)),
+            )
+        };
+        let mut last = None;
+        match options.t_search {
+            TSearch::Linear => {
+                for s in 0..=steps {
+                    let Some(found) = probe(s, &start, &mut ex)? else {
+                        break;
+                    };
+                    if options.warm_start {
+                        start.clone_from(&found.1.region_a);
+                    }
+                    last = Some(found);
+                }
             }
-            if options.warm_start {
-                start.clone_from(&pair.region_a);
+            TSearch::Bisect => {
+                // Bracket the last non-empty step by galloping from the previous pair's step
+                // (up while non-empty, down while empty), then bisect.
+                let s0 = prev_step.min(steps);
+                let (mut lo, mut hi) = (None::<usize>, None::<usize>);
+                let mut keep = |s: usize, found: (f64, StablePair), start: &mut Vec<u32>| {
+                    if options.warm_start {
+                        start.clone_from(&found.1.region_a);
+                    }
+                    last = Some(found);
+                    s
+                };
+                match probe(s0, &start, &mut ex)? {
+                    Some(found) => {
+                        lo = Some(keep(s0, found, &mut start));
+                        let mut d = 1;
+                        while lo != Some(steps) {
+                            let s = (s0 + d).min(steps);
+                            match probe(s, &start, &mut ex)? {
+                                Some(found) => lo = Some(keep(s, found, &mut start)),
+                                None => {
+                                    hi = Some(s);
+                                    break;
+                                }
+                            }
+                            d *= 2;
+                        }
+                    }
+                    None => {
+                        hi = Some(s0);
+                        let mut d = 1;
+                        while hi != Some(0) {
+                            let s = s0.saturating_sub(d);
+                            match probe(s, &start, &mut ex)? {
+                                Some(found) => {
+                                    lo = Some(keep(s, found, &mut start));
+                                    break;
+                                }
+                                None => hi = Some(s),
+                            }
+                            d *= 2;
+                        }
+                    }
+                }
+                if let (Some(mut lo), Some(mut hi)) = (lo, hi) {
+                    while hi - lo > 1 {
+                        let mid = lo + (hi - lo) / 2;
+                        match probe(mid, &start, &mut ex)? {
+                            Some(found) => lo = keep(mid, found, &mut start),
+                            None => hi = mid,
+                        }
+                    }
+                }
             }
-            last = Some((t, pair));
         }
         let Some((t, pt)) = last else { break };
+        prev_step = (t / options.delta_t).round() as usize;
         let alpha =
             (ex.area_a(&pt.region_a) / rem_area_a).max(ex.area_b(&pt.region_b) / rem_area_b);
         let opts = StablePairOptions {

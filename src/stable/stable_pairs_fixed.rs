@@ -1,9 +1,9 @@
 //! [`stable_pairs_fixed`]: Algorithm 2, several stable pairs with fixed thresholds.
 
+use super::stable_pair::stable_pair_inner;
 use super::stable_regions::{AreaReference, RegionPair, StableRegions, StableRegionsOptions};
 use super::{
     Remaining, StableError, StablePair, StablePairOptions, StableWorkspace, initial_indicator,
-    stable_pair_with,
 };
 use crate::affinity::BandAffinity;
 
@@ -84,7 +84,7 @@ impl<'s> Extraction<'s> {
             reference_area_a: reference.0,
             reference_area_b: reference.1,
         };
-        stable_pair_with(w, &rem, f0, opts, &mut self.ws)
+        stable_pair_inner(w, &rem, f0, opts, &mut self.ws)
     }
 
     /// Removes a pair from the remainder and records it.

@@ -27,9 +27,11 @@ pub enum Threshold {
 /// - `reference_area`: the area `α` is a fraction of (the remaining area, or the shape's total).
 /// - `scratch`: reused buffer.
 ///
+/// Cost: `O(n)` for `Count` and `MeanStd`, `O(n + m log m)` for `AreaFraction` selecting `m`.
+///
 /// ```
-/// use coseg::stable::{threshold, Threshold};
-/// let (mut out, mut scratch) = (Vec::new(), Vec::new());
+/// use coseg::stable::{threshold, Threshold, ThresholdScratch};
+/// let (mut out, mut scratch) = (Vec::new(), ThresholdScratch::default());
 /// let v = [0, 2, 5, 7];
 /// let s = [1.0, 3.0, 3.0, 2.0];
 /// threshold(Threshold::Count(2), &v, &s, &[1.0; 8], 4.0, &mut out, &mut scratch);
@@ -44,7 +46,7 @@ pub fn threshold(
     areas: &[f64],
     reference_area: f64,
     out: &mut Vec<u32>,
-    scratch: &mut Vec<u32>,
+    scratch: &mut ThresholdScratch,
 ) {
     debug_assert_eq!(vertices.len(), scores.len());
     out.clear();
@@ -52,12 +54,7 @@ pub fn threshold(
     if n == 0 {
         return;
     }
-    // Order: higher score first, then lower position (= lower vertex index).
-    let cmp = |a: &u32, b: &u32| {
-        scores[*b as usize]
-            .total_cmp(&scores[*a as usize])
-            .then(a.cmp(b))
-    };
+    let keys = &mut scratch.keys;
     match rule {
         Threshold::Count(p) => {
             if p >= n {
@@ -67,10 +64,9 @@ pub fn threshold(
             if p == 0 {
                 return;
             }
-            scratch.clear();
-            scratch.extend(0..n as u32);
-            scratch.select_nth_unstable_by(p - 1, cmp);
-            out.extend(scratch[..p].iter().map(|&i| vertices[i as usize]));
+            fill_keys(keys, scores);
+            keys.select_nth_unstable(p - 1);
+            out.extend(keys[..p].iter().map(|&k| vertices[(k as u32) as usize]));
             out.sort_unstable();
         }
         Threshold::AreaFraction(alpha) => {
@@ -78,18 +74,42 @@ pub fn threshold(
             if target.is_nan() || target <= 0.0 {
                 return;
             }
-            scratch.clear();
-            scratch.extend(0..n as u32);
-            scratch.sort_unstable_by(cmp);
-            let mut acc = 0.0;
-            for &i in scratch.iter() {
-                let v = vertices[i as usize];
-                out.push(v);
-                acc += areas[v as usize];
-                if acc >= target {
-                    break;
+            fill_keys(keys, scores);
+            // Most calls need a small prefix: select a generous candidate set first, sort only
+            // it, and fall back to a full sort when its area does not reach the target.
+            let total: f64 = vertices.iter().map(|&v| areas[v as usize]).sum();
+            let guess = ((target / total.max(f64::MIN_POSITIVE)) * n as f64 * 1.5) as usize + 64;
+            let mut prefix = n;
+            if guess < n {
+                keys.select_nth_unstable(guess - 1);
+                keys[..guess].sort_unstable();
+                let mut acc = 0.0;
+                if let Some(pos) = keys[..guess].iter().position(|&k| {
+                    acc += areas[vertices[(k as u32) as usize] as usize];
+                    acc >= target
+                }) {
+                    prefix = pos + 1;
+                } else {
+                    keys.sort_unstable();
                 }
+            } else {
+                keys.sort_unstable();
             }
+            if prefix == n {
+                let mut acc = 0.0;
+                prefix = keys
+                    .iter()
+                    .position(|&k| {
+                        acc += areas[vertices[(k as u32) as usize] as usize];
+                        acc >= target
+                    })
+                    .map_or(n, |p| p + 1);
+            }
+            out.extend(
+                keys[..prefix]
+                    .iter()
+                    .map(|&k| vertices[(k as u32) as usize]),
+            );
             out.sort_unstable();
         }
         Threshold::MeanStd(t) => {
@@ -116,4 +136,22 @@ pub fn threshold(
             );
         }
     }
+}
+
+/// Reusable buffer of [`threshold`].
+#[derive(Debug, Clone, Default)]
+pub struct ThresholdScratch {
+    keys: Vec<u128>,
+}
+
+/// Sort keys: ascending key order = descending score, then ascending position (the position is
+/// the low 32 bits).
+fn fill_keys(keys: &mut Vec<u128>, scores: &[f64]) {
+    keys.clear();
+    keys.extend(scores.iter().enumerate().map(|(i, &s)| {
+        let b = s.to_bits();
+        // Monotone map of the f64 total order onto u64.
+        let ord = if b >> 63 == 1 { !b } else { b | (1 << 63) };
+        ((!ord as u128) << 64) | i as u128
+    }));
 }

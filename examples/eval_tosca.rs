@@ -1,0 +1,222 @@
+//! Correspondence ratio (paper §7.2) on TOSCA within-class pairs, identity ground truth.
+//!
+//! ```text
+//! cargo run --release --example eval_tosca -- /work/shared/data/tosca [--cache DIR]
+//!     [--shapes 4] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
+//!     [--area-bands] [--eigenpairs k] [--hks n] [--wks n] [--curvature n]
+//! ```
+//! For every class, the first `--shapes` files `<class><i>.off` in increasing `i` are taken and
+//! every unordered pair is segmented; the table gives the mean ratio per class and overall for
+//! each configuration (Algorithm 2 at a 10 % area cutoff, Algorithm 3), plus the time spent in
+//! the stable-region algorithm (per-shape data are cached and excluded).
+
+use coseg::bands::BandWeighting;
+use coseg::cache::{ShapePipelineOptions, load_or_compute};
+use coseg::mesh::read_mesh;
+use coseg::stable::{
+    Algorithm, AreaReference, Init, StableRegionsOptions, TSearch, VertexMap, correspondence_stats,
+    stable_regions,
+};
+use std::path::PathBuf;
+use std::time::Instant;
+
+fn configs() -> Vec<(&'static str, StableRegionsOptions)> {
+    // Explicit inits: the configurations do not depend on the library's default.
+    let base = StableRegionsOptions {
+        init: Init::Extreme,
+        ..Default::default()
+    };
+    let auto = StableRegionsOptions {
+        algorithm: Algorithm::Auto,
+        ..base.clone()
+    };
+    vec![
+        ("alg2-extreme", base.clone()),
+        (
+            "alg2-random",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..base.clone()
+            },
+        ),
+        (
+            "alg2-extreme-remaining",
+            StableRegionsOptions {
+                area_reference: AreaReference::Remaining,
+                ..base.clone()
+            },
+        ),
+        ("alg3-extreme", auto.clone()),
+        (
+            "alg3-random",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..auto.clone()
+            },
+        ),
+        (
+            "alg3-extreme-linear",
+            StableRegionsOptions {
+                t_search: TSearch::Linear,
+                ..auto.clone()
+            },
+        ),
+        (
+            "alg3-random-linear-cold",
+            StableRegionsOptions {
+                init: Init::Random,
+                t_search: TSearch::Linear,
+                warm_start: false,
+                ..auto.clone()
+            },
+        ),
+    ]
+}
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut dir = None;
+    let mut cache = PathBuf::from("/tmp/coseg-eval-cache");
+    let mut shapes = 4usize;
+    let mut classes = vec![
+        "cat".to_string(),
+        "dog".into(),
+        "horse".into(),
+        "david".into(),
+    ];
+    let mut which = "all".to_string();
+    let mut pipe = ShapePipelineOptions::default();
+    let mut i = 0;
+    while i < args.len() {
+        let next = |i: usize| args.get(i + 1).cloned().unwrap_or_default();
+        match args[i].as_str() {
+            "--cache" => {
+                cache = next(i).into();
+                i += 1;
+            }
+            "--shapes" => {
+                shapes = next(i).parse()?;
+                i += 1;
+            }
+            "--classes" => {
+                classes = next(i).split(',').map(String::from).collect();
+                i += 1;
+            }
+            "--configs" => {
+                which = next(i);
+                i += 1;
+            }
+            "--bands" => {
+                pipe.bands.bands = next(i).parse()?;
+                i += 1;
+            }
+            "--eigenpairs" => {
+                pipe.spectrum.eigenpairs = next(i).parse()?;
+                i += 1;
+            }
+            "--hks" => {
+                pipe.descriptors.hks_count = next(i).parse()?;
+                i += 1;
+            }
+            "--wks" => {
+                pipe.descriptors.wks_count = next(i).parse()?;
+                i += 1;
+            }
+            "--curvature" => {
+                pipe.descriptors.curvature_count = next(i).parse()?;
+                i += 1;
+            }
+            "--area-bands" => pipe.bands.weighting = BandWeighting::Area,
+            d => dir = Some(PathBuf::from(d)),
+        }
+        i += 1;
+    }
+    let dir = dir.ok_or_else(|| anyhow::anyhow!("usage: eval_tosca DATA_DIR [options]"))?;
+    let configs: Vec<_> = configs()
+        .into_iter()
+        .filter(|(n, _)| which == "all" || which.split(',').any(|w| w == *n))
+        .collect();
+    println!("pipeline: {pipe:?}");
+    // Per class: the first `shapes` indices present.
+    let mut results = vec![vec![Vec::new(); classes.len()]; configs.len()];
+    let mut times = vec![0.0; configs.len()];
+    let mut stable_only = vec![Vec::new(); configs.len()];
+    let mut coverage = vec![Vec::new(); configs.len()];
+    for (ci, class) in classes.iter().enumerate() {
+        let mut idx: Vec<u32> = std::fs::read_dir(&dir)?
+            .filter_map(|e| e.ok())
+            .filter_map(|e| {
+                let n = e.file_name().to_string_lossy().into_owned();
+                n.strip_prefix(class.as_str())?
+                    .strip_suffix(".off")?
+                    .parse()
+                    .ok()
+            })
+            .collect();
+        idx.sort_unstable();
+        idx.truncate(shapes);
+        let mut data = Vec::new();
+        for &k in &idx {
+            let path = dir.join(format!("{class}{k}.off"));
+            let mesh = read_mesh(&path)?;
+            let t = Instant::now();
+            let d = load_or_compute(&mesh, &pipe, &cache)?;
+            eprintln!(
+                "{}: {} vertices, data in {:.1} s ({:?})",
+                path.display(),
+                mesh.vertex_count(),
+                t.elapsed().as_secs_f64(),
+                d.outcome
+            );
+            data.push((format!("{class}{k}"), mesh.vertex_areas(), d.data.bands));
+        }
+        for a in 0..data.len() {
+            for b in a + 1..data.len() {
+                let mut line = format!("{:>8} x {:<8}", data[a].0, data[b].0);
+                for (k, (_, opts)) in configs.iter().enumerate() {
+                    let t = Instant::now();
+                    let r = stable_regions(&data[a].2, &data[b].2, &data[a].1, &data[b].1, opts)?;
+                    times[k] += t.elapsed().as_secs_f64();
+                    let st = correspondence_stats(&r, &VertexMap::Identity)?;
+                    results[k][ci].push(st.ratio);
+                    stable_only[k].push(st.ratio_without_leftover);
+                    coverage[k].push(st.coverage);
+                    line += &format!(" {:>6.2}", 100.0 * st.ratio);
+                }
+                println!("{line}");
+            }
+        }
+    }
+    println!(
+        "\nmean correspondence ratio (%) per class, identity ground truth; then the ratio over"
+    );
+    println!("non-leftover regions only and their coverage (% of vertices):");
+    print!("{:<26}", "config");
+    for c in &classes {
+        print!(" {c:>7}");
+    }
+    println!(
+        " {:>7} {:>8} {:>14} {:>9}",
+        "mean", "time s", "w/o leftover", "coverage"
+    );
+    for (k, (name, _)) in configs.iter().enumerate() {
+        print!("{name:<26}");
+        let mut all = Vec::new();
+        for r in &results[k] {
+            print!(
+                " {:>7.2}",
+                100.0 * r.iter().sum::<f64>() / r.len().max(1) as f64
+            );
+            all.extend(r);
+        }
+        let mean = |v: &[f64]| 100.0 * v.iter().sum::<f64>() / v.len().max(1) as f64;
+        println!(
+            " {:>7.2} {:>8.2} {:>14.2} {:>9.2}",
+            mean(&all),
+            times[k],
+            mean(&stable_only[k]),
+            mean(&coverage[k])
+        );
+    }
+    Ok(())
+}
