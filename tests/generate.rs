@@ -3,14 +3,13 @@
 mod common;
 
 use common::generate::{
-    assert_closed_oriented_single, collections_dir, read_collection_obj, read_labels,
-    signed_volume,
+    assert_closed_oriented_single, collections_dir, read_collection_obj, read_labels, signed_volume,
 };
 use coseg::generate::{
-    generate_family, marching_tetrahedra, obj_text, write_collection, Collection, Family,
-    GenerateOptions, Manifest, ScalarGrid,
+    Collection, Family, GenerateOptions, Manifest, ScalarGrid, generate_family,
+    marching_tetrahedra, obj_text, write_collection,
 };
-use coseg::mesh::{edges, TriMesh};
+use coseg::mesh::{TriMesh, edges};
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 use std::sync::OnceLock;
@@ -95,7 +94,10 @@ fn marching_tetrahedra_sphere_is_closed_genus_zero_with_right_volume_and_area() 
         );
         for q in mesh.positions() {
             let r = (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]).sqrt();
-            assert!((r - 1.0).abs() < 0.1 * cell + 0.02, "vertex off the sphere: {r}");
+            assert!(
+                (r - 1.0).abs() < 0.1 * cell + 0.02,
+                "vertex off the sphere: {r}"
+            );
         }
     }
 }
@@ -212,7 +214,12 @@ fn every_shape_is_closed_manifold_single_component_and_outward() {
             let n = s.mesh.vertex_count();
             assert!((1500..=8000).contains(&n), "{}: {n} vertices", s.name);
             assert_eq!(s.labels.len(), n);
-            assert!(s.mesh.report().warnings.is_empty(), "{}: {:?}", s.name, s.mesh.report());
+            assert!(
+                s.mesh.report().warnings.is_empty(),
+                "{}: {:?}",
+                s.name,
+                s.mesh.report()
+            );
         }
     }
 }
@@ -227,11 +234,34 @@ fn every_present_part_has_vertices_and_absent_parts_have_none() {
                 let count = s.labels.iter().filter(|&&l| l == i as u32).count();
                 if s.parts_present[i] {
                     // At least 1% of the vertices: a real part, not a few stray labels.
-                    assert!(count * 100 >= s.labels.len(), "{}: part {name} has {count}", s.name);
+                    assert!(
+                        count * 100 >= s.labels.len(),
+                        "{}: part {name} has {count}",
+                        s.name
+                    );
                 } else {
                     assert_eq!(count, 0, "{}: absent part {name} labelled", s.name);
                 }
             }
+        }
+    }
+}
+
+#[test]
+fn topology_matches_the_construction() {
+    // No limb touches another part (that would add a handle): animals and humanoids are
+    // spheres; a cup handle adds one handle; each chair armrest closes one loop with the seat
+    // and the back. Euler characteristic χ = 2 − 2·genus.
+    for c in default_collections() {
+        let names = c.family.part_names();
+        for s in &c.shapes {
+            let has = |n: &str| s.parts_present[names.iter().position(|x| *x == n).unwrap()];
+            let genus = match c.family {
+                Family::Quadrupeds | Family::Humanoids => 0,
+                Family::Goblets => has("handle") as i64,
+                Family::Chairs => has("armrest_left") as i64 + has("armrest_right") as i64,
+            };
+            assert_eq!(euler_characteristic(&s.mesh), 2 - 2 * genus, "{}", s.name);
         }
     }
 }
@@ -242,7 +272,10 @@ fn optional_parts_are_present_on_some_shapes_and_absent_on_others() {
         let i = part_index(family, part) as usize;
         let c = collection(family);
         let with = c.shapes.iter().filter(|s| s.parts_present[i]).count();
-        assert!(with >= 2 && with + 2 <= c.shapes.len(), "{family}/{part}: {with}");
+        assert!(
+            with >= 2 && with + 2 <= c.shapes.len(),
+            "{family}/{part}: {with}"
+        );
     };
     check(Family::Goblets, "handle");
     check(Family::Chairs, "back");
@@ -264,8 +297,17 @@ fn labels_sit_where_the_parts_are() {
     for s in &collection(f).shapes {
         let c = |n| centroid(&s.mesh, &s.labels, part_index(f, n));
         let torso = c("torso");
-        assert!(c("head")[0] > torso[0] && c("tail")[0] < torso[0], "{}", s.name);
-        for leg in ["leg_front_left", "leg_front_right", "leg_back_left", "leg_back_right"] {
+        assert!(
+            c("head")[0] > torso[0] && c("tail")[0] < torso[0],
+            "{}",
+            s.name
+        );
+        for leg in [
+            "leg_front_left",
+            "leg_front_right",
+            "leg_back_left",
+            "leg_back_right",
+        ] {
             assert!(c(leg)[1] < torso[1], "{}: {leg}", s.name);
         }
         assert!(c("leg_front_left")[2] > 0.0 && c("leg_front_right")[2] < 0.0);
@@ -278,14 +320,26 @@ fn labels_sit_where_the_parts_are() {
         let torso = c("torso");
         assert!(c("head")[1] > torso[1], "{}", s.name);
         assert!(c("leg_left")[1] < torso[1] && c("leg_right")[1] < torso[1]);
-        assert!(c("arm_left")[0] > 0.0 && c("arm_right")[0] < 0.0, "{}", s.name);
-        assert!(c("leg_left")[0] > 0.0 && c("leg_right")[0] < 0.0, "{}", s.name);
+        assert!(
+            c("arm_left")[0] > 0.0 && c("arm_right")[0] < 0.0,
+            "{}",
+            s.name
+        );
+        assert!(
+            c("leg_left")[0] > 0.0 && c("leg_right")[0] < 0.0,
+            "{}",
+            s.name
+        );
     }
     // Goblets: base below stem below bowl; handle on +x.
     let f = Family::Goblets;
     for s in &collection(f).shapes {
         let c = |n| centroid(&s.mesh, &s.labels, part_index(f, n));
-        assert!(c("base")[1] < c("stem")[1] && c("stem")[1] < c("bowl")[1], "{}", s.name);
+        assert!(
+            c("base")[1] < c("stem")[1] && c("stem")[1] < c("bowl")[1],
+            "{}",
+            s.name
+        );
         if s.parts_present[part_index(f, "handle") as usize] {
             assert!(c("handle")[0] > 0.1, "{}", s.name);
         }
@@ -295,11 +349,20 @@ fn labels_sit_where_the_parts_are() {
     for s in &collection(f).shapes {
         let c = |n| centroid(&s.mesh, &s.labels, part_index(f, n));
         let seat = c("seat");
-        for leg in ["leg_front_left", "leg_front_right", "leg_back_left", "leg_back_right"] {
+        for leg in [
+            "leg_front_left",
+            "leg_front_right",
+            "leg_back_left",
+            "leg_back_right",
+        ] {
             assert!(c(leg)[1] < seat[1], "{}: {leg}", s.name);
         }
         if s.parts_present[part_index(f, "back") as usize] {
-            assert!(c("back")[1] > seat[1] && c("back")[2] < seat[2], "{}", s.name);
+            assert!(
+                c("back")[1] > seat[1] && c("back")[2] < seat[2],
+                "{}",
+                s.name
+            );
         }
     }
 }
@@ -322,7 +385,12 @@ fn proportions_and_resolutions_vary_by_large_factors() {
         q.shapes
             .iter()
             .map(|s| {
-                let min_y = s.mesh.positions().iter().map(|p| p[1]).fold(f64::MAX, f64::min);
+                let min_y = s
+                    .mesh
+                    .positions()
+                    .iter()
+                    .map(|p| p[1])
+                    .fold(f64::MAX, f64::min);
                 s.mesh
                     .positions()
                     .iter()
@@ -343,7 +411,12 @@ fn proportions_and_resolutions_vary_by_large_factors() {
     );
     assert!(stems >= 3.0, "goblet stem ratio {stems}");
     for c in default_collections() {
-        let v = ratio(c.shapes.iter().map(|s| s.mesh.vertex_count() as f64).collect());
+        let v = ratio(
+            c.shapes
+                .iter()
+                .map(|s| s.mesh.vertex_count() as f64)
+                .collect(),
+        );
         assert!(v >= 2.0, "{}: vertex count ratio {v}", c.family);
     }
 }
@@ -409,15 +482,26 @@ fn binary_regenerates_the_shipped_collections_byte_for_byte() {
         .arg(tmp.path())
         .output()
         .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     for family in Family::ALL {
         let shipped = collections_dir().join(family.name());
         let fresh = tmp.path().join(family.name());
-        assert_eq!(listing(&shipped), listing(&fresh), "{family}: file lists differ");
+        assert_eq!(
+            listing(&shipped),
+            listing(&fresh),
+            "{family}: file lists differ"
+        );
         for name in listing(&shipped) {
             let a = std::fs::read(shipped.join(&name)).unwrap();
             let b = std::fs::read(fresh.join(&name)).unwrap();
-            assert!(a == b, "{family}/{name}: regenerated bytes differ from collections/");
+            assert!(
+                a == b,
+                "{family}/{name}: regenerated bytes differ from collections/"
+            );
         }
     }
 }
