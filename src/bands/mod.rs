@@ -5,6 +5,12 @@
 
 use thiserror::Error;
 
+mod area_weighted_bands;
+mod band_table;
+
+pub use area_weighted_bands::area_weighted_bands;
+pub use band_table::{BandOptions, BandWeighting, band_table};
+
 /// Errors of the band stage.
 #[derive(Debug, Error)]
 pub enum BandError {
@@ -12,7 +18,9 @@ pub enum BandError {
     #[error("band count K = {0} must be in 1..=256")]
     BadBandCount(usize),
     /// The feature array does not have `features × vertices` entries.
-    #[error("expected {expected} feature values ({features} features × {vertices} vertices), got {got}")]
+    #[error(
+        "expected {expected} feature values ({features} features × {vertices} vertices), got {got}"
+    )]
     ShapeMismatch {
         /// Features.
         features: usize,
@@ -23,6 +31,10 @@ pub enum BandError {
         /// Actual length.
         got: usize,
     },
+    /// The vertex weights of area-weighted bands are not `d` finite non-negative numbers with a
+    /// positive sum.
+    #[error("bad vertex weights: {0}")]
+    BadWeights(String),
     /// A feature value is NaN.
     #[error("feature {feature} is NaN at vertex {vertex}")]
     NaN {
@@ -93,24 +105,77 @@ pub fn equal_count_bands(
             got: values.len(),
         });
     }
-    let mut labels = vec![0u8; features * vertices];
-    let mut order: Vec<u32> = Vec::with_capacity(vertices);
-    for k in 0..features {
-        let f = &values[k * vertices..(k + 1) * vertices];
-        if let Some(v) = f.iter().position(|x| x.is_nan()) {
-            return Err(BandError::NaN { feature: k, vertex: v });
-        }
-        order.clear();
-        order.extend(0..vertices as u32);
-        order.sort_unstable_by(|&a, &b| f[a as usize].total_cmp(&f[b as usize]).then(a.cmp(&b)));
-        let (base, extra) = (vertices / bands, vertices % bands);
-        let mut pos = 0usize;
-        for band in 0..bands {
-            let size = base + usize::from(band < extra);
-            for &v in &order[pos..pos + size] {
-                labels[v as usize * features + k] = band as u8;
+    ranked_labels(values, features, vertices, bands, None)
+}
+
+/// Shared engine of the band builders: per feature (in parallel, one feature per task so the
+/// result does not depend on the thread count), sort by value with ties by index, then cut by
+/// count (`weights = None`) or by cumulative weight (midpoint rule).
+pub(crate) fn ranked_labels(
+    values: &[f64],
+    features: usize,
+    vertices: usize,
+    bands: usize,
+    weights: Option<&[f64]>,
+) -> Result<BandTable, BandError> {
+    use rayon::prelude::*;
+    if let Some(f) = (0..features).find(|&k| {
+        values[k * vertices..(k + 1) * vertices]
+            .iter()
+            .any(|x| x.is_nan())
+    }) {
+        let v = values[f * vertices..(f + 1) * vertices]
+            .iter()
+            .position(|x| x.is_nan())
+            .unwrap_or(0);
+        return Err(BandError::NaN {
+            feature: f,
+            vertex: v,
+        });
+    }
+    let total: f64 = weights.map_or(0.0, |w| w.iter().sum());
+    let columns: Vec<Vec<u8>> = (0..features)
+        .into_par_iter()
+        .map_init(Vec::new, |keys: &mut Vec<u128>, k| {
+            let f = &values[k * vertices..(k + 1) * vertices];
+            keys.clear();
+            keys.extend(
+                f.iter()
+                    .enumerate()
+                    .map(|(v, &x)| ((order_bits(x) as u128) << 32) | v as u128),
+            );
+            keys.sort_unstable();
+            let mut col = vec![0u8; vertices];
+            match weights {
+                None => {
+                    let (base, extra) = (vertices / bands, vertices % bands);
+                    let mut pos = 0usize;
+                    for band in 0..bands {
+                        let size = base + usize::from(band < extra);
+                        for &key in &keys[pos..pos + size] {
+                            col[(key as u32) as usize] = band as u8;
+                        }
+                        pos += size;
+                    }
+                }
+                Some(w) => {
+                    let mut before = 0.0f64;
+                    for &key in keys.iter() {
+                        let v = (key as u32) as usize;
+                        let mid = before + 0.5 * w[v];
+                        before += w[v];
+                        let b = ((mid / total) * bands as f64).floor();
+                        col[v] = (b.max(0.0) as usize).min(bands - 1) as u8;
+                    }
+                }
             }
-            pos += size;
+            col
+        })
+        .collect();
+    let mut labels = vec![0u8; features * vertices];
+    for (k, col) in columns.iter().enumerate() {
+        for (v, &b) in col.iter().enumerate() {
+            labels[v * features + k] = b;
         }
     }
     Ok(BandTable {
@@ -119,4 +184,11 @@ pub fn equal_count_bands(
         bands,
         labels,
     })
+}
+
+/// Maps an `f64` to a `u64` whose unsigned order is `f64::total_cmp`'s order.
+#[inline]
+fn order_bits(x: f64) -> u64 {
+    let b = x.to_bits();
+    if b >> 63 == 1 { !b } else { b | (1 << 63) }
 }

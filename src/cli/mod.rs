@@ -1,5 +1,7 @@
 //! Subcommands of the `coseg` binary, one file each.
 
+mod convert;
+mod features;
 mod generate;
 mod info;
 
@@ -23,6 +25,10 @@ pub struct Cli {
 enum Command {
     /// Load meshes, validate them and print their counts and warnings.
     Info(info::InfoArgs),
+    /// Convert a mesh between OBJ, OFF and PLY (format by extension), keeping vertex order.
+    Convert(convert::ConvertArgs),
+    /// Compute a mesh's descriptors and band table and export them (.npy or .csv).
+    Features(features::FeaturesArgs),
     /// Generate a synthetic shape family with ground-truth part labels.
     Generate(generate::GenerateArgs),
 }
@@ -31,6 +37,8 @@ enum Command {
 pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Info(args) => info::run(args),
+        Command::Convert(args) => convert::run(args),
+        Command::Features(args) => features::run(args),
         Command::Generate(args) => generate::run(args),
     }
 }

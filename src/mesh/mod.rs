@@ -14,8 +14,11 @@ pub mod io;
 mod topology;
 mod validate;
 
-pub use io::{read_mesh, read_mesh_with_report, write_mesh, MeshFormat, PlyVertexProperty};
-pub use topology::{boundary_edges, connected_components, edges, Components};
+pub use io::{
+    MeshFormat, PlyVertexProperty, read_mesh, read_mesh_from_bytes, read_mesh_with_report,
+    write_atomic, write_mesh,
+};
+pub use topology::{Components, boundary_edges, connected_components, edges};
 pub use validate::{MeshReport, MeshWarning};
 
 /// Errors raised while reading, writing or building a mesh. Every variant that concerns a file
@@ -62,7 +65,7 @@ pub enum MeshError {
         path: String,
         /// Face number (0-based, after triangulation).
         face: usize,
-        /// The offending index.
+        /// The offending index, 0-based (an OBJ file's 1-based `k` is reported as `k - 1`).
         index: u64,
         /// Number of vertices.
         vertices: usize,
@@ -82,6 +85,31 @@ pub enum MeshError {
         path: String,
         /// The total area found.
         area: f64,
+    },
+    /// The file ends before all the records its header (or its syntax) announces.
+    #[error("{path}: truncated file: {message}")]
+    Truncated {
+        /// The file concerned.
+        path: String,
+        /// What was expected and where the file ends (line number where known).
+        message: String,
+    },
+    /// The file's header is wrong, or declares something coseg does not read (an unknown
+    /// encoding, a missing or unsupported element or property type).
+    #[error("{path}: {message}")]
+    Header {
+        /// The file concerned.
+        path: String,
+        /// What is wrong ("wrong header: …" or "unsupported …").
+        message: String,
+    },
+    /// A per-vertex property given to a writer is invalid (wrong length or name).
+    #[error("{path}: {message}")]
+    Property {
+        /// The file concerned.
+        path: String,
+        /// What is wrong.
+        message: String,
     },
     /// More vertices than a `u32` index can address.
     #[error("{path}: {vertices} vertices exceed the u32 index range")]
@@ -122,6 +150,9 @@ impl MeshError {
             MeshError::NonFinite { vertex, .. } => MeshError::NonFinite { path: p, vertex },
             MeshError::ZeroArea { area, .. } => MeshError::ZeroArea { path: p, area },
             MeshError::TooLarge { vertices, .. } => MeshError::TooLarge { path: p, vertices },
+            MeshError::Truncated { message, .. } => MeshError::Truncated { path: p, message },
+            MeshError::Header { message, .. } => MeshError::Header { path: p, message },
+            MeshError::Property { message, .. } => MeshError::Property { path: p, message },
         }
     }
 }
@@ -189,7 +220,7 @@ impl TriMesh {
         }
         let mesh = TriMesh { positions, faces };
         let area = mesh.total_area();
-        if !(area > 0.0) || !area.is_finite() {
+        if area <= 0.0 || !area.is_finite() {
             return Err(MeshError::ZeroArea { path, area });
         }
         Ok(mesh)

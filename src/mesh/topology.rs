@@ -72,13 +72,13 @@ pub fn connected_components(mesh: &TriMesh) -> Components {
     let mut labels = vec![u32::MAX; d];
     let mut count = 0usize;
     let mut root_label = vec![u32::MAX; d];
-    for v in 0..d {
+    for (v, label) in labels.iter_mut().enumerate() {
         let r = find(&mut parent, v as u32) as usize;
         if root_label[r] == u32::MAX {
             root_label[r] = count as u32;
             count += 1;
         }
-        labels[v] = root_label[r];
+        *label = root_label[r];
     }
     Components { labels, count }
 }

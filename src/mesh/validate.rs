@@ -1,6 +1,6 @@
 //! Conditions a mesh can have that the method survives, reported as warnings.
 
-use super::{topology, TriMesh};
+use super::{TriMesh, topology};
 use std::fmt;
 
 /// Something about a mesh that the method survives but a user should know of.
@@ -50,7 +50,10 @@ impl fmt::Display for MeshWarning {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             MeshWarning::DegenerateFaces { count, first } => {
-                write!(f, "{count} degenerate (zero-area) triangles, first is face {first}")
+                write!(
+                    f,
+                    "{count} degenerate (zero-area) triangles, first is face {first}"
+                )
             }
             MeshWarning::DuplicateFaces { count, first } => {
                 write!(f, "{count} duplicate faces, first is face {first}")

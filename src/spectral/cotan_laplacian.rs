@@ -1,4 +1,4 @@
-use crate::mesh::{cross, dot, norm, sub, TriMesh};
+use crate::mesh::{TriMesh, cross, dot, norm, sub};
 use faer::sparse::{SparseColMat, Triplet};
 
 /// Largest magnitude allowed for a cotangent weight. Nearly degenerate triangles have

@@ -1,4 +1,4 @@
-use super::{cotan_laplacian, lumped_mass, SpectralError, Spectrum};
+use super::{SpectralError, Spectrum, cotan_laplacian, lumped_mass};
 use crate::mesh::TriMesh;
 
 /// Options of [`laplace_beltrami_spectrum`].
@@ -35,7 +35,10 @@ pub fn dense_spectrum(mesh: &TriMesh, k: usize) -> Result<Spectrum, SpectralErro
     }
     let original_area = mesh.total_area();
     // L is scale invariant; M scales with area, so unit area means M / A.
-    let mass: Vec<f64> = lumped_mass(mesh).iter().map(|m| m / original_area).collect();
+    let mass: Vec<f64> = lumped_mass(mesh)
+        .iter()
+        .map(|m| m / original_area)
+        .collect();
     let l = cotan_laplacian(mesh);
     let inv_sqrt: Vec<f64> = mass
         .iter()

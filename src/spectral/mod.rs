@@ -10,9 +10,7 @@ mod laplace_beltrami_spectrum;
 mod lumped_mass;
 
 pub use cotan_laplacian::cotan_laplacian;
-pub use laplace_beltrami_spectrum::{
-    dense_spectrum, laplace_beltrami_spectrum, SpectrumOptions,
-};
+pub use laplace_beltrami_spectrum::{SpectrumOptions, dense_spectrum, laplace_beltrami_spectrum};
 pub use lumped_mass::lumped_mass;
 
 use thiserror::Error;

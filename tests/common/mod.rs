@@ -1,4 +1,7 @@
-//! Shared test fixtures, one module per area.
+//! Shared test fixtures, one file per area.
 #![allow(dead_code)]
 
+pub mod features;
 pub mod generate;
+pub mod mesh;
+pub mod stable;

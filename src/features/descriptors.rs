@@ -1,0 +1,210 @@
+use super::{
+    FeatureError, SpectralBand, heat_kernel_signature, multiscale_mean_curvature, scale_grid,
+    wave_kernel_signature,
+};
+use crate::mesh::TriMesh;
+use crate::spectral::Spectrum;
+
+/// Options of [`descriptors`]. Every field changes the result (and so belongs in a cache key).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct DescriptorOptions {
+    /// Number of HKS features (default 100).
+    pub hks_count: usize,
+    /// Number of WKS features (default 100).
+    pub wks_count: usize,
+    /// Number of multiscale mean-curvature features (default 100).
+    pub curvature_count: usize,
+    /// The eigenvalue band the time/energy grids are derived from (default
+    /// [`SpectralBand::Weyl`]); see [`scale_grid`](super::scale_grid) for the rule.
+    pub band: SpectralBand,
+    /// WKS `σ` as a multiple of `(ln λ_hi − ln λ_lo) / wks_count` (default 7, as pyFM).
+    pub wks_sigma_multiple: f64,
+    /// Eigenvalues `≤` this (unit area) are treated as zero and left out of the WKS
+    /// (default 1e-5, as pyFM).
+    pub zero_eigenvalue: f64,
+}
+
+impl Default for DescriptorOptions {
+    fn default() -> Self {
+        DescriptorOptions {
+            hks_count: 100,
+            wks_count: 100,
+            curvature_count: 100,
+            band: SpectralBand::Weyl,
+            wks_sigma_multiple: 7.0,
+            zero_eigenvalue: 1e-5,
+        }
+    }
+}
+
+/// Which family a feature belongs to, with its scale.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub enum FeatureKind {
+    /// Heat kernel signature at diffusion time `t` (unit area).
+    Hks(f64),
+    /// Wave kernel signature at log-energy `e`.
+    Wks(f64),
+    /// Mean curvature diffused for time `t` (unit area).
+    MeanCurvature(f64),
+}
+
+impl FeatureKind {
+    /// A short name such as `hks_003` (family and index within the family).
+    pub fn family(&self) -> &'static str {
+        match self {
+            FeatureKind::Hks(_) => "hks",
+            FeatureKind::Wks(_) => "wks",
+            FeatureKind::MeanCurvature(_) => "curv",
+        }
+    }
+
+    /// The scale: `t` for HKS and curvature, `e` for WKS.
+    pub fn scale(&self) -> f64 {
+        match *self {
+            FeatureKind::Hks(t) | FeatureKind::Wks(t) | FeatureKind::MeanCurvature(t) => t,
+        }
+    }
+}
+
+/// The feature table of one shape: `N = hks + wks + curvature` features on `d` vertices.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Descriptors {
+    /// Number of vertices `d`.
+    pub vertices: usize,
+    /// HKS times (unit area), ascending; features `0..hks`.
+    pub hks_times: Vec<f64>,
+    /// WKS log-energies, ascending; the next `wks` features.
+    pub wks_energies: Vec<f64>,
+    /// WKS Gaussian width (log-eigenvalue units).
+    pub wks_sigma: f64,
+    /// Mean-curvature diffusion times (unit area), ascending; the last features.
+    pub curvature_times: Vec<f64>,
+    /// Unit-area vertex areas (length `d`, sum 1), for area-weighted bands.
+    pub vertex_areas: Vec<f64>,
+    /// `N × d` values, feature-major: `values[f * d + v]`.
+    pub values: Vec<f64>,
+}
+
+impl Descriptors {
+    /// Number of features `N`.
+    pub fn feature_count(&self) -> usize {
+        self.hks_times.len() + self.wks_energies.len() + self.curvature_times.len()
+    }
+
+    /// Feature `f` (length `d`).
+    pub fn feature(&self, f: usize) -> &[f64] {
+        &self.values[f * self.vertices..(f + 1) * self.vertices]
+    }
+
+    /// Family and scale of every feature, in table order.
+    pub fn kinds(&self) -> Vec<FeatureKind> {
+        self.hks_times
+            .iter()
+            .map(|&t| FeatureKind::Hks(t))
+            .chain(self.wks_energies.iter().map(|&e| FeatureKind::Wks(e)))
+            .chain(
+                self.curvature_times
+                    .iter()
+                    .map(|&t| FeatureKind::MeanCurvature(t)),
+            )
+            .collect()
+    }
+
+    /// Column names such as `hks_000`, `wks_099`, `curv_042`, in table order.
+    pub fn names(&self) -> Vec<String> {
+        let mut names = Vec::with_capacity(self.feature_count());
+        for (fam, n) in [
+            ("hks", self.hks_times.len()),
+            ("wks", self.wks_energies.len()),
+            ("curv", self.curvature_times.len()),
+        ] {
+            names.extend((0..n).map(|i| format!("{fam}_{i:03}")));
+        }
+        names
+    }
+}
+
+/// HKS, WKS and multiscale mean curvature of a mesh from its (unit-area) spectrum, on the
+/// shape-independent scale grid of [`scale_grid`](super::scale_grid) (with `k` =
+/// `spectrum.len()`).
+///
+/// Invariant to rigid motions and uniform scaling of the mesh; a vertex permutation permutes
+/// the columns. Bit-identical on every run and any number of threads.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, spectral::dense_spectrum};
+/// use coseg::features::{descriptors, DescriptorOptions};
+/// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
+/// let s = dense_spectrum(&m, 4).unwrap();
+/// let opts = DescriptorOptions { hks_count: 3, wks_count: 2, curvature_count: 1, ..Default::default() };
+/// let f = descriptors(&m, &s, &opts).unwrap();
+/// assert_eq!(f.feature_count(), 6);
+/// assert_eq!(f.values.len(), 6 * 4);
+/// ```
+pub fn descriptors(
+    mesh: &TriMesh,
+    spectrum: &Spectrum,
+    options: &DescriptorOptions,
+) -> Result<Descriptors, FeatureError> {
+    let d = mesh.vertex_count();
+    if spectrum.vertex_count() != d {
+        return Err(FeatureError::VertexMismatch {
+            mesh: d,
+            spectrum: spectrum.vertex_count(),
+        });
+    }
+    if spectrum.is_empty() || spectrum.eigenvectors.len() != d * spectrum.len() {
+        return Err(FeatureError::EmptySpectrum(format!(
+            "{} eigenvalues, {} eigenvector entries for {d} vertices",
+            spectrum.len(),
+            spectrum.eigenvectors.len()
+        )));
+    }
+    if spectrum
+        .eigenvalues
+        .iter()
+        .chain(&spectrum.eigenvectors)
+        .any(|x| !x.is_finite())
+    {
+        return Err(FeatureError::EmptySpectrum(
+            "the spectrum has non-finite entries".into(),
+        ));
+    }
+    let grid = scale_grid(
+        &options.band,
+        spectrum.len(),
+        options.hks_count,
+        options.wks_count,
+        options.curvature_count,
+        options.wks_sigma_multiple,
+    )?;
+    let (hks, (wks, curv)) = rayon::join(
+        || heat_kernel_signature(spectrum, &grid.hks_times),
+        || {
+            rayon::join(
+                || {
+                    wave_kernel_signature(
+                        spectrum,
+                        &grid.wks_energies,
+                        grid.wks_sigma,
+                        options.zero_eigenvalue,
+                    )
+                },
+                || multiscale_mean_curvature(mesh, spectrum, &grid.curvature_times),
+            )
+        },
+    );
+    let curv = curv?;
+    let mut values = hks;
+    values.extend_from_slice(&wks);
+    values.extend_from_slice(&curv);
+    Ok(Descriptors {
+        vertices: d,
+        hks_times: grid.hks_times,
+        wks_energies: grid.wks_energies,
+        wks_sigma: grid.wks_sigma,
+        curvature_times: grid.curvature_times,
+        vertex_areas: spectrum.vertex_areas.clone(),
+        values,
+    })
+}

@@ -1,0 +1,510 @@
+//! Tests of the thresholding functions and Algorithms 1–3 against a dense oracle.
+
+mod common;
+
+use common::stable::{noisy_copy, random_table, random_vec};
+use coseg::affinity::{BandAffinity, dense_affinity};
+use coseg::stable::{Remaining, StablePairOptions, Threshold, stable_pair, threshold};
+
+fn all(n: usize) -> Vec<u32> {
+    (0..n as u32).collect()
+}
+
+/// Σ_{q ∈ g, p ∈ f} W_qp from the dense matrix.
+fn dense_objective(d: &[f64], cols: usize, f: &[u32], g: &[u32]) -> f64 {
+    g.iter()
+        .map(|&q| {
+            f.iter()
+                .map(|&p| d[q as usize * cols + p as usize])
+                .sum::<f64>()
+        })
+        .sum()
+}
+
+#[test]
+fn count_threshold_breaks_ties_by_index() {
+    let v = [1, 3, 4, 8, 9];
+    let s = [2.0, 5.0, 2.0, 2.0, 5.0];
+    let (mut out, mut sc) = (Vec::new(), Vec::new());
+    let areas = vec![1.0; 10];
+    threshold(Threshold::Count(3), &v, &s, &areas, 5.0, &mut out, &mut sc);
+    assert_eq!(out, vec![1, 3, 9]);
+    threshold(Threshold::Count(4), &v, &s, &areas, 5.0, &mut out, &mut sc);
+    assert_eq!(out, vec![1, 3, 4, 9]);
+    threshold(Threshold::Count(0), &v, &s, &areas, 5.0, &mut out, &mut sc);
+    assert!(out.is_empty());
+    threshold(Threshold::Count(9), &v, &s, &areas, 5.0, &mut out, &mut sc);
+    assert_eq!(out, v.to_vec());
+}
+
+#[test]
+fn area_threshold_stops_at_first_prefix_reaching_alpha() {
+    let v = [0, 1, 2, 3];
+    let s = [4.0, 3.0, 3.0, 1.0];
+    let areas = [1.0, 2.0, 0.5, 1.5];
+    let (mut out, mut sc) = (Vec::new(), Vec::new());
+    // Order: 0 (1.0), 1 (3.0), 2 (3.5), 3 (5.0). α·5 = 3 → {0, 1}.
+    threshold(
+        Threshold::AreaFraction(0.6),
+        &v,
+        &s,
+        &areas,
+        5.0,
+        &mut out,
+        &mut sc,
+    );
+    assert_eq!(out, vec![0, 1]);
+    threshold(
+        Threshold::AreaFraction(0.61),
+        &v,
+        &s,
+        &areas,
+        5.0,
+        &mut out,
+        &mut sc,
+    );
+    assert_eq!(out, vec![0, 1, 2]);
+    threshold(
+        Threshold::AreaFraction(0.0),
+        &v,
+        &s,
+        &areas,
+        5.0,
+        &mut out,
+        &mut sc,
+    );
+    assert!(out.is_empty());
+    threshold(
+        Threshold::AreaFraction(2.0),
+        &v,
+        &s,
+        &areas,
+        5.0,
+        &mut out,
+        &mut sc,
+    );
+    assert_eq!(out, vec![0, 1, 2, 3]);
+}
+
+#[test]
+fn mean_std_threshold() {
+    let v = [0, 1, 2, 3];
+    let s = [1.0, 2.0, 3.0, 4.0]; // μ = 2.5, σ = √1.25
+    let (mut out, mut sc) = (Vec::new(), Vec::new());
+    let areas = [1.0; 4];
+    threshold(
+        Threshold::MeanStd(0.0),
+        &v,
+        &s,
+        &areas,
+        4.0,
+        &mut out,
+        &mut sc,
+    );
+    assert_eq!(out, vec![2, 3]);
+    threshold(
+        Threshold::MeanStd(1.0),
+        &v,
+        &s,
+        &areas,
+        4.0,
+        &mut out,
+        &mut sc,
+    );
+    assert_eq!(out, vec![3]); // 2.5 + 1.118 = 3.618
+    threshold(
+        Threshold::MeanStd(1.5),
+        &v,
+        &s,
+        &areas,
+        4.0,
+        &mut out,
+        &mut sc,
+    );
+    assert!(out.is_empty()); // 2.5 + 1.677 > 4
+    threshold(
+        Threshold::MeanStd(-1.0),
+        &v,
+        &s,
+        &areas,
+        4.0,
+        &mut out,
+        &mut sc,
+    );
+    assert_eq!(out, vec![1, 2, 3]);
+    let flat = [2.0; 4];
+    threshold(
+        Threshold::MeanStd(0.0),
+        &v,
+        &flat,
+        &areas,
+        4.0,
+        &mut out,
+        &mut sc,
+    );
+    assert_eq!(out, vec![0, 1, 2, 3]);
+    threshold(
+        Threshold::MeanStd(0.1),
+        &v,
+        &flat,
+        &areas,
+        4.0,
+        &mut out,
+        &mut sc,
+    );
+    assert!(out.is_empty());
+}
+
+/// Checks W-stability of (f, g) on the remaining sets with the dense W: no single exchange of
+/// a selected vertex for an unselected one increases Σ W.
+fn assert_w_stable(d: &[f64], cols: usize, ra: &[u32], rb: &[u32], f: &[u32], g: &[u32]) {
+    // Scores of B vertices against f, of A vertices against g.
+    let sb: Vec<f64> = rb
+        .iter()
+        .map(|&q| f.iter().map(|&p| d[q as usize * cols + p as usize]).sum())
+        .collect();
+    let sa: Vec<f64> = ra
+        .iter()
+        .map(|&p| g.iter().map(|&q| d[q as usize * cols + p as usize]).sum())
+        .collect();
+    let tol = 1e-15;
+    let min_in_b = rb
+        .iter()
+        .zip(&sb)
+        .filter(|(q, _)| g.contains(q))
+        .map(|(_, s)| *s)
+        .fold(f64::INFINITY, f64::min);
+    let max_out_b = rb
+        .iter()
+        .zip(&sb)
+        .filter(|(q, _)| !g.contains(q))
+        .map(|(_, s)| *s)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        max_out_b <= min_in_b + tol,
+        "B swap improves: {max_out_b} > {min_in_b}"
+    );
+    let min_in_a = ra
+        .iter()
+        .zip(&sa)
+        .filter(|(p, _)| f.contains(p))
+        .map(|(_, s)| *s)
+        .fold(f64::INFINITY, f64::min);
+    let max_out_a = ra
+        .iter()
+        .zip(&sa)
+        .filter(|(p, _)| !f.contains(p))
+        .map(|(_, s)| *s)
+        .fold(f64::NEG_INFINITY, f64::max);
+    assert!(
+        max_out_a <= min_in_a + tol,
+        "A swap improves: {max_out_a} > {min_in_a}"
+    );
+}
+
+#[test]
+fn algorithm1_fixed_sizes_returns_w_stable_pairs_with_monotone_objective() {
+    let mut hit_cap = 0;
+    for seed in 0..40u64 {
+        let (da, db, n, k) = (60 + seed as usize, 75, 12, 6);
+        let a = random_table(da, n, k, seed);
+        // Correlated B on a prefix so the problem has structure, random otherwise.
+        let b = if seed % 2 == 0 {
+            random_table(db, n, k, 1000 + seed)
+        } else {
+            let mut c = noisy_copy(&random_table(db, n, k, seed), 0.6, 2000 + seed);
+            c.vertices = db;
+            c
+        };
+        let w = BandAffinity::new(&a, &b).unwrap();
+        let d = dense_affinity(&w).unwrap();
+        // A remaining subset: drop every 5th vertex.
+        let ra: Vec<u32> = all(da).into_iter().filter(|v| v % 5 != 1).collect();
+        let rb: Vec<u32> = all(db).into_iter().filter(|v| v % 7 != 3).collect();
+        let areas_a = vec![1.0; da];
+        let areas_b = vec![1.0; db];
+        let rem = Remaining {
+            vertices_a: &ra,
+            vertices_b: &rb,
+            areas_a: &areas_a,
+            areas_b: &areas_b,
+            reference_area_a: ra.len() as f64,
+            reference_area_b: rb.len() as f64,
+        };
+        let x = random_vec(da, seed + 77);
+        let f0: Vec<u32> = all(da)
+            .into_iter()
+            .filter(|&p| x[p as usize] < 0.3)
+            .collect();
+        let (p, q) = (5 + (seed as usize % 11), 4 + (seed as usize % 13));
+        let opts = StablePairOptions {
+            p: Threshold::Count(p),
+            q: Threshold::Count(q),
+            max_iterations: 200,
+        };
+        let pair = stable_pair(&w, &rem, &f0, &opts).unwrap();
+        if !pair.converged {
+            hit_cap += 1;
+            continue;
+        }
+        assert_eq!(pair.region_a.len(), q);
+        assert_eq!(pair.region_b.len(), p);
+        assert!(pair.region_a.iter().all(|v| ra.binary_search(v).is_ok()));
+        assert!(pair.region_b.iter().all(|v| rb.binary_search(v).is_ok()));
+        assert_w_stable(&d, da, &ra, &rb, &pair.region_a, &pair.region_b);
+        // history[0] pairs the initial f⁽⁰⁾ (of arbitrary size); from then on sizes are fixed.
+        for h in pair.history[1..].windows(2) {
+            assert!(
+                h[1] >= h[0] - 1e-15,
+                "objective decreased: {:?}",
+                pair.history
+            );
+        }
+        let obj = dense_objective(&d, da, &pair.region_a, &pair.region_b);
+        assert!((obj - pair.objective).abs() <= 1e-12 * obj.max(1e-300));
+        assert!(pair.iterations < 200);
+    }
+    assert_eq!(
+        hit_cap, 0,
+        "Algorithm 1 failed to converge on random instances"
+    );
+}
+
+#[test]
+fn algorithm1_is_deterministic_and_thread_independent() {
+    let a = random_table(3000, 20, 20, 1);
+    let b = noisy_copy(&a, 0.7, 2);
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let ra = all(3000);
+    let areas = random_vec(3000, 3);
+    let total: f64 = areas.iter().sum();
+    let rem = Remaining {
+        vertices_a: &ra,
+        vertices_b: &ra,
+        areas_a: &areas,
+        areas_b: &areas,
+        reference_area_a: total,
+        reference_area_b: total,
+    };
+    let opts = StablePairOptions::default();
+    let run = || stable_pair(&w, &rem, &[5, 17, 2000], &opts).unwrap();
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(run);
+    let two = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(run);
+    assert_eq!(one, two);
+    assert!(one.converged);
+    // Area rule: the region's area is the first prefix to reach 10 %.
+    let area_a: f64 = one.region_a.iter().map(|&v| areas[v as usize]).sum();
+    assert!(area_a >= 0.1 * total);
+}
+
+use coseg::bands::BandTable;
+use coseg::stable::{
+    Algorithm, AreaReference, Init, StableRegions, StableRegionsOptions, VertexMap,
+    correspondence_ratio, stable_pairs_auto, stable_pairs_fixed, stable_regions,
+};
+
+/// B = A with its vertices permuted: `perm[p]` is p's index in B.
+fn permuted(a: &BandTable, seed: u64) -> (BandTable, Vec<u32>) {
+    let x = random_vec(a.vertices, seed);
+    let mut order: Vec<u32> = (0..a.vertices as u32).collect();
+    order.sort_by(|&i, &j| x[i as usize].total_cmp(&x[j as usize]));
+    // order[q] = source vertex of B's vertex q.
+    let mut perm = vec![0u32; a.vertices];
+    let mut labels = vec![0u8; a.labels.len()];
+    for (q, &p) in order.iter().enumerate() {
+        perm[p as usize] = q as u32;
+        labels[q * a.features..(q + 1) * a.features].copy_from_slice(a.row(p as usize));
+    }
+    (
+        BandTable {
+            labels,
+            ..a.clone()
+        },
+        perm,
+    )
+}
+
+fn assert_partition(r: &StableRegions) {
+    for (n, labels) in [(r.vertices_a, r.labels_a()), (r.vertices_b, r.labels_b())] {
+        assert_eq!(labels.len(), n);
+        assert!(labels.iter().all(|&l| l >= 0), "every vertex in a region");
+    }
+    let total_a: usize = r.pairs.iter().map(|p| p.region_a.len()).sum();
+    let total_b: usize = r.pairs.iter().map(|p| p.region_b.len()).sum();
+    assert_eq!(total_a, r.vertices_a, "regions of A are disjoint");
+    assert_eq!(total_b, r.vertices_b, "regions of B are disjoint");
+    assert!(r.pairs.last().unwrap().leftover);
+}
+
+/// A smooth synthetic "shape": features are noisy monotone functions of a few latent
+/// coordinates, so neighbouring vertices share bands and regions are meaningful.
+fn latent_table(n: usize, features: usize, bands: usize, seed: u64) -> BandTable {
+    let lat = random_vec(3 * n, seed);
+    let noise = random_vec(n * features, seed + 1);
+    let mut values = vec![0.0; features * n];
+    for k in 0..features {
+        let c = [(k % 3) as f64, ((k / 3) % 3) as f64 - 1.0, 1.0];
+        for v in 0..n {
+            values[k * n + v] = c[0] * lat[3 * v]
+                + c[1] * lat[3 * v + 1]
+                + c[2] * lat[3 * v + 2] * lat[3 * v]
+                + 0.05 * noise[v * features + k];
+        }
+    }
+    coseg::bands::equal_count_bands(&values, features, n, bands).unwrap()
+}
+
+#[test]
+fn algorithm2_partitions_recovers_a_relabelled_copy_and_is_deterministic() {
+    let a = latent_table(2000, 24, 10, 3);
+    let (b, perm) = permuted(&a, 4);
+    let areas_a = random_vec(2000, 5)
+        .iter()
+        .map(|x| 0.5 + x)
+        .collect::<Vec<_>>();
+    let mut areas_b = vec![0.0; 2000];
+    for p in 0..2000 {
+        areas_b[perm[p] as usize] = areas_a[p];
+    }
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let map = VertexMap::Explicit(perm.iter().map(|&q| Some(q)).collect());
+    for init in [Init::Extreme, Init::Random] {
+        let opts = StableRegionsOptions {
+            init,
+            ..Default::default()
+        };
+        let r = stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap();
+        assert_eq!(r.pairs.len(), 10);
+        assert_partition(&r);
+        let total: f64 = areas_a.iter().sum();
+        for p in &r.pairs[..9] {
+            assert!(p.converged);
+            // First prefix reaching 10 % of the total area: at least 10 %, less than 10 % + one vertex.
+            assert!(p.area_fraction_a >= 0.1 && p.area_fraction_a < 0.1 + 1.5 / total);
+        }
+        let ratio = correspondence_ratio(&r, &map).unwrap();
+        eprintln!("ratio {ratio}");
+        assert!(ratio > 0.9, "{init:?}: ratio {ratio}");
+        // Identity is the wrong map here: a correct algorithm scores near chance.
+        assert!(correspondence_ratio(&r, &VertexMap::Identity).unwrap() < 0.3);
+        let again = stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap();
+        assert_eq!(r, again);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        assert_eq!(
+            one.install(|| stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap()),
+            r
+        );
+    }
+    // Remaining-area reference: each pair takes 10 % of what is left.
+    let opts = StableRegionsOptions {
+        area_reference: AreaReference::Remaining,
+        ..Default::default()
+    };
+    let r = stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap();
+    assert_partition(&r);
+    assert!(r.pairs[1].area_fraction_a < r.pairs[0].area_fraction_a);
+}
+
+#[test]
+fn algorithm2_random_init_depends_on_seed_only() {
+    let a = latent_table(1500, 12, 8, 11);
+    let b = latent_table(1700, 12, 8, 12);
+    let (wa, wb) = (vec![1.0; 1500], vec![1.0; 1700]);
+    let run = |seed| {
+        let opts = StableRegionsOptions {
+            init: Init::Random,
+            seed,
+            ..Default::default()
+        };
+        stable_regions(&a, &b, &wa, &wb, &opts).unwrap()
+    };
+    assert_eq!(run(1), run(1));
+    assert_ne!(run(1), run(2));
+}
+
+#[test]
+fn algorithm3_partitions_and_reports_thresholds() {
+    let a = latent_table(2000, 24, 10, 21);
+    let (b, perm) = permuted(&a, 22);
+    let areas = vec![1.0; 2000];
+    let opts = StableRegionsOptions {
+        algorithm: Algorithm::Auto,
+        pairs: 8,
+        ..Default::default()
+    };
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let r = stable_pairs_auto(&w, &areas, &areas, &opts).unwrap();
+    assert_partition(&r);
+    assert!(r.pairs.len() >= 2);
+    for p in r.pairs.iter().filter(|p| !p.leftover) {
+        let auto = p.auto.unwrap();
+        assert!(auto.t >= 0.0 && auto.alpha > 0.0 && auto.alpha <= 1.0);
+        assert!(!p.region_a.is_empty() && !p.region_b.is_empty());
+    }
+    let map = VertexMap::Explicit(perm.iter().map(|&q| Some(q)).collect());
+    let ratio = correspondence_ratio(&r, &map).unwrap();
+    assert!(ratio > 0.9, "ratio {ratio}");
+    let again = stable_regions(&a, &b, &areas, &areas, &opts).unwrap();
+    assert_eq!(r, again);
+}
+
+#[test]
+fn correspondence_ratio_counts_matches_and_checks_maps() {
+    let a = latent_table(300, 6, 5, 1);
+    let areas = vec![1.0; 300];
+    let r = stable_regions(&a, &a, &areas, &areas, &StableRegionsOptions::default()).unwrap();
+    // A shape against itself: every region maps onto itself.
+    assert_eq!(correspondence_ratio(&r, &VertexMap::Identity).unwrap(), 1.0);
+    let bad = VertexMap::Explicit(vec![Some(0); 10]);
+    assert!(correspondence_ratio(&r, &bad).is_err());
+    let out_of_range = VertexMap::Explicit(vec![Some(300); 300]);
+    assert!(correspondence_ratio(&r, &out_of_range).is_err());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("map.txt");
+    std::fs::write(&path, "# header\n2\n-1\n0\n").unwrap();
+    assert_eq!(
+        VertexMap::read(&path).unwrap(),
+        VertexMap::Explicit(vec![Some(2), None, Some(0)])
+    );
+    std::fs::write(&path, "2\nx\n").unwrap();
+    let err = VertexMap::read(&path).unwrap_err().to_string();
+    assert!(err.contains("map.txt:2"), "{err}");
+}
+
+#[test]
+fn options_are_validated() {
+    let a = latent_table(100, 4, 5, 1);
+    let areas = vec![1.0; 100];
+    let zero = StableRegionsOptions {
+        pairs: 0,
+        ..Default::default()
+    };
+    assert!(stable_regions(&a, &a, &areas, &areas, &zero).is_err());
+    let bad_dt = StableRegionsOptions {
+        algorithm: Algorithm::Auto,
+        delta_t: 0.0,
+        ..Default::default()
+    };
+    assert!(stable_regions(&a, &a, &areas, &areas, &bad_dt).is_err());
+    assert!(
+        stable_regions(
+            &a,
+            &a,
+            &areas[..99],
+            &areas,
+            &StableRegionsOptions::default()
+        )
+        .is_err()
+    );
+}
