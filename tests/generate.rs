@@ -529,6 +529,9 @@ fn shipped_files_agree_with_their_manifest() {
             }
             assert_eq!(counts, s.label_counts, "{}", s.name);
         }
+        // The crate's own reader sees the same mesh.
+        let path = dir.join(&manifest.shapes[0].mesh);
+        assert_eq!(coseg::mesh::read_mesh(&path).unwrap(), read_collection_obj(&path));
         // The file holds exactly the generated mesh (coordinates were rounded before writing).
         let c = collection(family);
         let first = read_collection_obj(&dir.join(&manifest.shapes[0].mesh));
