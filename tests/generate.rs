@@ -531,7 +531,10 @@ fn shipped_files_agree_with_their_manifest() {
         }
         // The crate's own reader sees the same mesh.
         let path = dir.join(&manifest.shapes[0].mesh);
-        assert_eq!(coseg::mesh::read_mesh(&path).unwrap(), read_collection_obj(&path));
+        assert_eq!(
+            coseg::mesh::read_mesh(&path).unwrap(),
+            read_collection_obj(&path)
+        );
         // The file holds exactly the generated mesh (coordinates were rounded before writing).
         let c = collection(family);
         let first = read_collection_obj(&dir.join(&manifest.shapes[0].mesh));
@@ -553,4 +556,31 @@ fn write_collection_writes_manifest_that_round_trips() {
     let m: Manifest = serde_json::from_str(&text).unwrap();
     assert_eq!(m, Manifest::of(&c, &options));
     assert_eq!(listing(tmp.path()).len(), 3);
+}
+
+#[test]
+fn binary_takes_seed_and_count_and_rejects_unknown_families() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .args(["generate", "goblets", "--seed", "5", "--count", "2", "-o"])
+        .arg(tmp.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let m: Manifest =
+        serde_json::from_str(&std::fs::read_to_string(tmp.path().join("manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!((m.seed, m.shapes.len()), (5, 2));
+    assert_eq!(listing(tmp.path()).len(), 5);
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .args(["generate", "dragons", "-o"])
+        .arg(tmp.path().join("x"))
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown family"));
 }

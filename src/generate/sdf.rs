@@ -483,7 +483,7 @@ mod tests {
             }
         }
         // Level 2 over level 0 is at least (hi/lo)^0.7.
-        assert!((hi / lo as f64).powf(0.7) > 2.0);
+        assert!(f64::powf(hi / lo, 0.7) > 2.0);
     }
 
     #[test]
