@@ -378,7 +378,8 @@ fn chair(index: usize, p: &mut Params) -> Model {
     };
     let mut legs = Vec::new();
     for (sx, sz) in [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)] {
-        let top = [sx * (w - lr - 0.02), seat_y, sz * (dp - lr - 0.02)];
+        // The leg starts at the seat's underside so its rounded end stays inside the seat.
+        let top = [sx * (w - lr - 0.02), seat_y - st, sz * (dp - lr - 0.02)];
         let dir = [sx * splay, -1.0, sz * splay];
         let k = leg_len / (1.0 + 2.0 * splay * splay).sqrt();
         let foot = add(top, scale(dir, k));
