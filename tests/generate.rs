@@ -248,6 +248,25 @@ fn every_present_part_has_vertices_and_absent_parts_have_none() {
 }
 
 #[test]
+fn topology_matches_the_construction() {
+    // No limb touches another part (that would add a handle): animals and humanoids are
+    // spheres; a cup handle adds one handle; each chair armrest closes one loop with the seat
+    // and the back. Euler characteristic χ = 2 − 2·genus.
+    for c in default_collections() {
+        let names = c.family.part_names();
+        for s in &c.shapes {
+            let has = |n: &str| s.parts_present[names.iter().position(|x| *x == n).unwrap()];
+            let genus = match c.family {
+                Family::Quadrupeds | Family::Humanoids => 0,
+                Family::Goblets => has("handle") as i64,
+                Family::Chairs => has("armrest_left") as i64 + has("armrest_right") as i64,
+            };
+            assert_eq!(euler_characteristic(&s.mesh), 2 - 2 * genus, "{}", s.name);
+        }
+    }
+}
+
+#[test]
 fn optional_parts_are_present_on_some_shapes_and_absent_on_others() {
     let check = |family: Family, part: &str| {
         let i = part_index(family, part) as usize;
@@ -510,6 +529,12 @@ fn shipped_files_agree_with_their_manifest() {
             }
             assert_eq!(counts, s.label_counts, "{}", s.name);
         }
+        // The crate's own reader sees the same mesh.
+        let path = dir.join(&manifest.shapes[0].mesh);
+        assert_eq!(
+            coseg::mesh::read_mesh(&path).unwrap(),
+            read_collection_obj(&path)
+        );
         // The file holds exactly the generated mesh (coordinates were rounded before writing).
         let c = collection(family);
         let first = read_collection_obj(&dir.join(&manifest.shapes[0].mesh));
@@ -531,4 +556,31 @@ fn write_collection_writes_manifest_that_round_trips() {
     let m: Manifest = serde_json::from_str(&text).unwrap();
     assert_eq!(m, Manifest::of(&c, &options));
     assert_eq!(listing(tmp.path()).len(), 3);
+}
+
+#[test]
+fn binary_takes_seed_and_count_and_rejects_unknown_families() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .args(["generate", "goblets", "--seed", "5", "--count", "2", "-o"])
+        .arg(tmp.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let m: Manifest =
+        serde_json::from_str(&std::fs::read_to_string(tmp.path().join("manifest.json")).unwrap())
+            .unwrap();
+    assert_eq!((m.seed, m.shapes.len()), (5, 2));
+    assert_eq!(listing(tmp.path()).len(), 5);
+    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .args(["generate", "dragons", "-o"])
+        .arg(tmp.path().join("x"))
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown family"));
 }

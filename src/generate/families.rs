@@ -7,6 +7,46 @@ use super::sdf::{
 
 const DOWN: V3 = [0.0, -1.0, 0.0];
 
+/// How many times a colliding pose is redrawn before it is accepted anyway.
+const MAX_REDRAWS: usize = 50;
+
+/// A limb segment that must stay clear of the other parts (the limb's own part, and the torso
+/// when `skip_torso`, excepted): at 9 points along `a`–`b` (only the 5 of the far half when
+/// `skip_torso`: the near end is the attachment), every other part's signed distance exceeds
+/// `r + clearance`.
+struct Clearance {
+    part: usize,
+    a: V3,
+    b: V3,
+    r: f64,
+    skip_torso: bool,
+}
+
+/// Gap kept between a limb and other parts for grid spacing `cell`: larger than every blend
+/// radius and than 1.6 cells, so the polygonised surfaces stay apart too.
+fn clearance(cell: f64) -> f64 {
+    (1.6 * cell).max(0.06)
+}
+
+impl Clearance {
+    fn holds(&self, model: &Model, clearance: f64) -> bool {
+        let first = if self.skip_torso { 4 } else { 0 };
+        (first..9).all(|k| {
+            let p = add(
+                self.a,
+                scale(super::sdf::sub(self.b, self.a), k as f64 / 8.0),
+            );
+            model.parts.iter().enumerate().all(|(i, part)| {
+                i == self.part
+                    || (self.skip_torso && i == 0)
+                    || part
+                        .as_ref()
+                        .is_none_or(|part| part.eval(p) > self.r + clearance)
+            })
+        })
+    }
+}
+
 fn part(primitives: Vec<Primitive>, blend: f64) -> Option<Part> {
     Some(Part { primitives, blend })
 }
@@ -17,20 +57,30 @@ fn capsule(a: V3, b: V3, ra: f64, rb: f64) -> Primitive {
 
 /// Builds shape number `index` of `family` from `params`; returns the model and the grid cell.
 pub(crate) fn build(family: Family, index: usize, params: &mut Params) -> (Model, f64) {
-    let model = match family {
-        Family::Quadrupeds => quadruped(index, params),
-        Family::Humanoids => humanoid(index, params),
-        Family::Goblets => goblet(index, params),
-        Family::Chairs => chair(index, params),
-    };
     // Resolution: cell size drawn per shape (vertex counts differ by 2×+ across a family),
-    // capped at the thinnest primitive radius (so it spans at least 2 cells across).
-    // Stratified over thirds of the range (shape i in third i mod 3) so every family of 3+
-    // shapes spans fine and coarse grids.
+    // spread over the range (shape i at level i mod 3, see `Params::spread`) so every family of
+    // 3+ shapes spans fine and coarse grids; then capped at the thinnest primitive radius.
     let (lo, hi) = family.cell_range();
-    let third = (hi - lo) / 3.0;
-    let level = (index % 3) as f64;
-    let drawn = params.uniform("cell_drawn", lo + level * third, lo + (level + 1.0) * third);
+    let drawn = params.spread("cell_drawn", lo, hi, index % 3);
+    let clearance = clearance(drawn);
+    // Poses whose limbs run into other parts are redrawn (the stream continues, so this is
+    // deterministic); only the accepted draw is kept in the record.
+    let mark = params.drawn.len();
+    let mut rejected = 0;
+    let model = loop {
+        let (model, checks) = match family {
+            Family::Quadrupeds => quadruped(index, params, clearance),
+            Family::Humanoids => humanoid(index, params, clearance),
+            Family::Goblets => (goblet(index, params), Vec::new()),
+            Family::Chairs => (chair(index, params), Vec::new()),
+        };
+        if rejected == MAX_REDRAWS || checks.iter().all(|c| c.holds(&model, clearance)) {
+            break model;
+        }
+        rejected += 1;
+        params.drawn.truncate(mark);
+    };
+    params.record("rejected_poses", rejected as f64);
     let cap = super::sdf::round_to(model.thickness(), 1e4);
     let cell = drawn.min(cap);
     params.record("cell", cell);
@@ -49,7 +99,7 @@ fn torso_level(index: usize) -> usize {
 }
 
 /// Quadruped: torso, head (with neck), four two-segment legs, tail.
-fn quadruped(index: usize, p: &mut Params) -> Model {
+fn quadruped(index: usize, p: &mut Params, clear: f64) -> (Model, Vec<Clearance>) {
     let torso_len = p.spread("torso_length", 0.65, 1.5, torso_level(index));
     let rt = p.uniform("torso_radius", 0.17, 0.26);
     let leg_len = p.spread("leg_length", 0.32, 0.96, limb_level(index));
@@ -62,21 +112,43 @@ fn quadruped(index: usize, p: &mut Params) -> Model {
         rot: IDENTITY,
     };
     let mut legs = Vec::new();
-    for (name, front, side) in [
+    let mut checks = Vec::new();
+    for (k, (name, front, side)) in [
         ("leg_front_left", true, 1.0),
         ("leg_front_right", true, -1.0),
         ("leg_back_left", false, 1.0),
         ("leg_back_right", false, -1.0),
-    ] {
+    ]
+    .into_iter()
+    .enumerate()
+    {
         let swing = p.uniform(&format!("{name}_swing"), -0.5, 0.5);
         let knee = p.uniform(&format!("{name}_knee"), 0.0, 0.7);
         let x = if front { 0.375 } else { -0.375 } * torso_len;
-        let hip = [x, yc - 0.5 * rt, side * 0.55 * rt];
+        let hip = [
+            x,
+            yc - 0.5 * rt,
+            side * (0.55 * rt).max(1.15 * rl + 0.5 * clear + 0.01),
+        ];
         let upper = mat_vec(&rotation(2, swing), DOWN);
         let bend = if front { -knee } else { knee };
         let lower = mat_vec(&rotation(2, swing + bend), DOWN);
         let knee_p = add(hip, scale(upper, 0.5 * leg_len));
         let foot = add(knee_p, scale(lower, 0.5 * leg_len));
+        checks.push(Clearance {
+            part: 2 + k,
+            a: knee_p,
+            b: foot,
+            r: rl,
+            skip_torso: true,
+        });
+        checks.push(Clearance {
+            part: 2 + k,
+            a: hip,
+            b: knee_p,
+            r: 1.15 * rl,
+            skip_torso: true,
+        });
         legs.push(part(
             vec![
                 capsule(hip, knee_p, 1.15 * rl, rl),
@@ -118,11 +190,11 @@ fn quadruped(index: usize, p: &mut Params) -> Model {
     let mut parts = vec![part(vec![torso], 0.0), head];
     parts.extend(legs);
     parts.push(tail);
-    Model { parts, blend: 0.05 }
+    (Model { parts, blend: 0.05 }, checks)
 }
 
 /// Humanoid: torso, head (with neck), two two-segment arms, two two-segment legs.
-fn humanoid(index: usize, p: &mut Params) -> Model {
+fn humanoid(index: usize, p: &mut Params, clear: f64) -> (Model, Vec<Clearance>) {
     let leg_len = p.spread("leg_length", 0.5, 1.15, limb_level(index));
     let lr = p.uniform("leg_radius", 0.08, 0.11);
     let torso_len = p.uniform("torso_length", 0.45, 0.8);
@@ -151,7 +223,11 @@ fn humanoid(index: usize, p: &mut Params) -> Model {
         0.04,
     );
     let mut arms = Vec::new();
-    for (name, side) in [("arm_left", 1.0), ("arm_right", -1.0)] {
+    let mut checks = Vec::new();
+    for (k, (name, side)) in [("arm_left", 1.0), ("arm_right", -1.0)]
+        .into_iter()
+        .enumerate()
+    {
         let abduct = p.uniform(&format!("{name}_abduction"), 0.35, 1.6);
         let swing = p.uniform(&format!("{name}_swing"), -0.6, 0.6);
         let elbow = p.uniform(&format!("{name}_elbow"), 0.0, 1.2);
@@ -161,6 +237,20 @@ fn humanoid(index: usize, p: &mut Params) -> Model {
         let lower = mat_vec(&mat_mul(&base, &rotation(0, -swing - elbow)), DOWN);
         let elbow_p = add(shoulder, scale(upper, 0.5 * arm_len));
         let hand = add(elbow_p, scale(lower, 0.5 * arm_len));
+        checks.push(Clearance {
+            part: 2 + k,
+            a: elbow_p,
+            b: hand,
+            r: ar,
+            skip_torso: false,
+        });
+        checks.push(Clearance {
+            part: 2 + k,
+            a: shoulder,
+            b: elbow_p,
+            r: 1.1 * ar,
+            skip_torso: true,
+        });
         arms.push(part(
             vec![
                 capsule(shoulder, elbow_p, 1.1 * ar, ar),
@@ -170,16 +260,30 @@ fn humanoid(index: usize, p: &mut Params) -> Model {
         ));
     }
     let mut legs = Vec::new();
-    for (name, side) in [("leg_left", 1.0), ("leg_right", -1.0)] {
+    for (k, (name, side)) in [("leg_left", 1.0), ("leg_right", -1.0)]
+        .into_iter()
+        .enumerate()
+    {
         let swing = p.uniform(&format!("{name}_swing"), -0.6, 0.6);
         let spread = p.uniform(&format!("{name}_spread"), 0.05, 0.3);
         let knee = p.uniform(&format!("{name}_knee"), 0.0, 0.8);
-        let hip = [side * (0.55 * tw).max(lr + 0.045), leg_len + 0.05, 0.0];
+        let hip = [
+            side * (0.55 * tw).max(1.1 * lr + 0.5 * clear + 0.01),
+            leg_len + 0.05,
+            0.0,
+        ];
         let base = rotation(2, side * spread);
         let upper = mat_vec(&mat_mul(&base, &rotation(0, -swing)), DOWN);
         let lower = mat_vec(&mat_mul(&base, &rotation(0, -swing + knee)), DOWN);
         let knee_p = add(hip, scale(upper, 0.5 * leg_len));
         let foot = add(knee_p, scale(lower, 0.5 * leg_len));
+        checks.push(Clearance {
+            part: 4 + k,
+            a: knee_p,
+            b: foot,
+            r: lr,
+            skip_torso: true,
+        });
         legs.push(part(
             vec![
                 capsule(hip, knee_p, 1.1 * lr, lr),
@@ -191,7 +295,7 @@ fn humanoid(index: usize, p: &mut Params) -> Model {
     let mut parts = vec![part(vec![torso], 0.0), head];
     parts.extend(arms);
     parts.extend(legs);
-    Model { parts, blend: 0.05 }
+    (Model { parts, blend: 0.05 }, checks)
 }
 
 /// Goblet or cup: bowl (open spherical shell), stem, foot (base), handle on odd-numbered
@@ -262,7 +366,7 @@ fn chair(index: usize, p: &mut Params) -> Model {
     let lr = p.uniform("leg_radius", 0.05, 0.065);
     let splay = p.uniform("leg_splay", 0.0, 0.2);
     let has_back = index % 3 != 1;
-    let has_arms = has_back && index % 2 == 0;
+    let has_arms = has_back && index.is_multiple_of(2);
     p.record("back", if has_back { 1.0 } else { 0.0 });
     p.record("armrests", if has_arms { 1.0 } else { 0.0 });
     let seat_y = leg_len + st;
@@ -274,7 +378,8 @@ fn chair(index: usize, p: &mut Params) -> Model {
     };
     let mut legs = Vec::new();
     for (sx, sz) in [(1.0, 1.0), (-1.0, 1.0), (1.0, -1.0), (-1.0, -1.0)] {
-        let top = [sx * (w - lr - 0.02), seat_y, sz * (dp - lr - 0.02)];
+        // The leg starts at the seat's underside so its rounded end stays inside the seat.
+        let top = [sx * (w - lr - 0.02), seat_y - st, sz * (dp - lr - 0.02)];
         let dir = [sx * splay, -1.0, sz * splay];
         let k = leg_len / (1.0 + 2.0 * splay * splay).sqrt();
         let foot = add(top, scale(dir, k));

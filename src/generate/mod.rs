@@ -139,10 +139,10 @@ impl Family {
     /// Range of the grid spacing drawn per shape (model units).
     pub(crate) fn cell_range(self) -> (f64, f64) {
         match self {
-            Family::Quadrupeds => (0.05, 0.08),
-            Family::Humanoids => (0.04, 0.085),
-            Family::Goblets => (0.048, 0.08),
-            Family::Chairs => (0.036, 0.058),
+            Family::Quadrupeds => (0.045, 0.082),
+            Family::Humanoids => (0.044, 0.085),
+            Family::Goblets => (0.052, 0.085),
+            Family::Chairs => (0.04, 0.064),
         }
     }
 }

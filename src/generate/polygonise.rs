@@ -104,7 +104,8 @@ fn relax(positions: &mut [V3], faces: &[[u32; 3]], model: &Model, cell: f64, ite
         l.sort_unstable();
         l.dedup();
     }
-    let min_area2 = (1e-4 * cell * cell).powi(2);
+    let min_area = 1e-4 * cell * cell;
+    let min_area2 = min_area * min_area;
     for _ in 0..iterations {
         for v in 0..n {
             let old = positions[v];

@@ -471,6 +471,33 @@ mod tests {
     }
 
     #[test]
+    fn spread_stays_in_its_window_and_separates_levels() {
+        let mut p = Params::new(3, 0);
+        let (lo, hi) = (0.3, 0.9);
+        for level in 0..3 {
+            let (a, b) = [(0.0, 0.15), (0.35, 0.65), (0.85, 1.0)][level];
+            for _ in 0..200 {
+                let x = p.spread("x", lo, hi, level);
+                let (wlo, whi) = (lo * (hi / lo).powf(a), lo * (hi / lo).powf(b));
+                assert!(x >= wlo - 1e-4 && x <= whi + 1e-4, "level {level}: {x}");
+            }
+        }
+        // Level 2 over level 0 is at least (hi/lo)^0.7.
+        assert!(f64::powf(hi / lo, 0.7) > 2.0);
+    }
+
+    #[test]
+    fn params_are_deterministic_per_seed_and_stream() {
+        let draw = |seed, stream| {
+            let mut p = Params::new(seed, stream);
+            (0..5).map(|_| p.uniform("u", 0.0, 1.0)).collect::<Vec<_>>()
+        };
+        assert_eq!(draw(1, 2), draw(1, 2));
+        assert_ne!(draw(1, 2), draw(1, 3));
+        assert_ne!(draw(1, 2), draw(2, 2));
+    }
+
+    #[test]
     fn smin_is_min_far_apart_and_below_min_near() {
         assert_eq!(smin(1.0, 3.0, 0.5), 1.0);
         assert!(smin(1.0, 1.1, 0.5) < 1.0);
