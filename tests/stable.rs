@@ -304,3 +304,207 @@ fn algorithm1_is_deterministic_and_thread_independent() {
     let area_a: f64 = one.region_a.iter().map(|&v| areas[v as usize]).sum();
     assert!(area_a >= 0.1 * total);
 }
+
+use coseg::bands::BandTable;
+use coseg::stable::{
+    Algorithm, AreaReference, Init, StableRegions, StableRegionsOptions, VertexMap,
+    correspondence_ratio, stable_pairs_auto, stable_pairs_fixed, stable_regions,
+};
+
+/// B = A with its vertices permuted: `perm[p]` is p's index in B.
+fn permuted(a: &BandTable, seed: u64) -> (BandTable, Vec<u32>) {
+    let x = random_vec(a.vertices, seed);
+    let mut order: Vec<u32> = (0..a.vertices as u32).collect();
+    order.sort_by(|&i, &j| x[i as usize].total_cmp(&x[j as usize]));
+    // order[q] = source vertex of B's vertex q.
+    let mut perm = vec![0u32; a.vertices];
+    let mut labels = vec![0u8; a.labels.len()];
+    for (q, &p) in order.iter().enumerate() {
+        perm[p as usize] = q as u32;
+        labels[q * a.features..(q + 1) * a.features].copy_from_slice(a.row(p as usize));
+    }
+    (
+        BandTable {
+            labels,
+            ..a.clone()
+        },
+        perm,
+    )
+}
+
+fn assert_partition(r: &StableRegions) {
+    for (n, labels) in [(r.vertices_a, r.labels_a()), (r.vertices_b, r.labels_b())] {
+        assert_eq!(labels.len(), n);
+        assert!(labels.iter().all(|&l| l >= 0), "every vertex in a region");
+    }
+    let total_a: usize = r.pairs.iter().map(|p| p.region_a.len()).sum();
+    let total_b: usize = r.pairs.iter().map(|p| p.region_b.len()).sum();
+    assert_eq!(total_a, r.vertices_a, "regions of A are disjoint");
+    assert_eq!(total_b, r.vertices_b, "regions of B are disjoint");
+    assert!(r.pairs.last().unwrap().leftover);
+}
+
+/// A smooth synthetic "shape": features are noisy monotone functions of a few latent
+/// coordinates, so neighbouring vertices share bands and regions are meaningful.
+fn latent_table(n: usize, features: usize, bands: usize, seed: u64) -> BandTable {
+    let lat = random_vec(3 * n, seed);
+    let noise = random_vec(n * features, seed + 1);
+    let mut values = vec![0.0; features * n];
+    for k in 0..features {
+        let c = [(k % 3) as f64, ((k / 3) % 3) as f64 - 1.0, 1.0];
+        for v in 0..n {
+            values[k * n + v] = c[0] * lat[3 * v]
+                + c[1] * lat[3 * v + 1]
+                + c[2] * lat[3 * v + 2] * lat[3 * v]
+                + 0.05 * noise[v * features + k];
+        }
+    }
+    coseg::bands::equal_count_bands(&values, features, n, bands).unwrap()
+}
+
+#[test]
+fn algorithm2_partitions_recovers_a_relabelled_copy_and_is_deterministic() {
+    let a = latent_table(2000, 24, 10, 3);
+    let (b, perm) = permuted(&a, 4);
+    let areas_a = random_vec(2000, 5)
+        .iter()
+        .map(|x| 0.5 + x)
+        .collect::<Vec<_>>();
+    let mut areas_b = vec![0.0; 2000];
+    for p in 0..2000 {
+        areas_b[perm[p] as usize] = areas_a[p];
+    }
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let map = VertexMap::Explicit(perm.iter().map(|&q| Some(q)).collect());
+    for init in [Init::Extreme, Init::Random] {
+        let opts = StableRegionsOptions {
+            init,
+            ..Default::default()
+        };
+        let r = stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap();
+        assert_eq!(r.pairs.len(), 10);
+        assert_partition(&r);
+        let total: f64 = areas_a.iter().sum();
+        for p in &r.pairs[..9] {
+            assert!(p.converged);
+            // First prefix reaching 10 % of the total area: at least 10 %, less than 10 % + one vertex.
+            assert!(p.area_fraction_a >= 0.1 && p.area_fraction_a < 0.1 + 1.5 / total);
+        }
+        let ratio = correspondence_ratio(&r, &map).unwrap();
+        eprintln!("ratio {ratio}");
+        assert!(ratio > 0.9, "{init:?}: ratio {ratio}");
+        // Identity is the wrong map here: a correct algorithm scores near chance.
+        assert!(correspondence_ratio(&r, &VertexMap::Identity).unwrap() < 0.3);
+        let again = stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap();
+        assert_eq!(r, again);
+        let one = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        assert_eq!(
+            one.install(|| stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap()),
+            r
+        );
+    }
+    // Remaining-area reference: each pair takes 10 % of what is left.
+    let opts = StableRegionsOptions {
+        area_reference: AreaReference::Remaining,
+        ..Default::default()
+    };
+    let r = stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap();
+    assert_partition(&r);
+    assert!(r.pairs[1].area_fraction_a < r.pairs[0].area_fraction_a);
+}
+
+#[test]
+fn algorithm2_random_init_depends_on_seed_only() {
+    let a = latent_table(1500, 12, 8, 11);
+    let b = latent_table(1700, 12, 8, 12);
+    let (wa, wb) = (vec![1.0; 1500], vec![1.0; 1700]);
+    let run = |seed| {
+        let opts = StableRegionsOptions {
+            init: Init::Random,
+            seed,
+            ..Default::default()
+        };
+        stable_regions(&a, &b, &wa, &wb, &opts).unwrap()
+    };
+    assert_eq!(run(1), run(1));
+    assert_ne!(run(1), run(2));
+}
+
+#[test]
+fn algorithm3_partitions_and_reports_thresholds() {
+    let a = latent_table(2000, 24, 10, 21);
+    let (b, perm) = permuted(&a, 22);
+    let areas = vec![1.0; 2000];
+    let opts = StableRegionsOptions {
+        algorithm: Algorithm::Auto,
+        pairs: 8,
+        ..Default::default()
+    };
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let r = stable_pairs_auto(&w, &areas, &areas, &opts).unwrap();
+    assert_partition(&r);
+    assert!(r.pairs.len() >= 2);
+    for p in r.pairs.iter().filter(|p| !p.leftover) {
+        let auto = p.auto.unwrap();
+        assert!(auto.t >= 0.0 && auto.alpha > 0.0 && auto.alpha <= 1.0);
+        assert!(!p.region_a.is_empty() && !p.region_b.is_empty());
+    }
+    let map = VertexMap::Explicit(perm.iter().map(|&q| Some(q)).collect());
+    let ratio = correspondence_ratio(&r, &map).unwrap();
+    assert!(ratio > 0.9, "ratio {ratio}");
+    let again = stable_regions(&a, &b, &areas, &areas, &opts).unwrap();
+    assert_eq!(r, again);
+}
+
+#[test]
+fn correspondence_ratio_counts_matches_and_checks_maps() {
+    let a = latent_table(300, 6, 5, 1);
+    let areas = vec![1.0; 300];
+    let r = stable_regions(&a, &a, &areas, &areas, &StableRegionsOptions::default()).unwrap();
+    // A shape against itself: every region maps onto itself.
+    assert_eq!(correspondence_ratio(&r, &VertexMap::Identity).unwrap(), 1.0);
+    let bad = VertexMap::Explicit(vec![Some(0); 10]);
+    assert!(correspondence_ratio(&r, &bad).is_err());
+    let out_of_range = VertexMap::Explicit(vec![Some(300); 300]);
+    assert!(correspondence_ratio(&r, &out_of_range).is_err());
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("map.txt");
+    std::fs::write(&path, "# header\n2\n-1\n0\n").unwrap();
+    assert_eq!(
+        VertexMap::read(&path).unwrap(),
+        VertexMap::Explicit(vec![Some(2), None, Some(0)])
+    );
+    std::fs::write(&path, "2\nx\n").unwrap();
+    let err = VertexMap::read(&path).unwrap_err().to_string();
+    assert!(err.contains("map.txt:2"), "{err}");
+}
+
+#[test]
+fn options_are_validated() {
+    let a = latent_table(100, 4, 5, 1);
+    let areas = vec![1.0; 100];
+    let zero = StableRegionsOptions {
+        pairs: 0,
+        ..Default::default()
+    };
+    assert!(stable_regions(&a, &a, &areas, &areas, &zero).is_err());
+    let bad_dt = StableRegionsOptions {
+        algorithm: Algorithm::Auto,
+        delta_t: 0.0,
+        ..Default::default()
+    };
+    assert!(stable_regions(&a, &a, &areas, &areas, &bad_dt).is_err());
+    assert!(
+        stable_regions(
+            &a,
+            &a,
+            &areas[..99],
+            &areas,
+            &StableRegionsOptions::default()
+        )
+        .is_err()
+    );
+}

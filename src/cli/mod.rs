@@ -1,6 +1,8 @@
 //! Subcommands of the `coseg` binary, one file each.
 
 mod convert;
+mod features;
+mod generate;
 mod info;
 
 use clap::{Parser, Subcommand};
@@ -25,6 +27,10 @@ enum Command {
     Info(info::InfoArgs),
     /// Convert a mesh between OBJ, OFF and PLY (format by extension), keeping vertex order.
     Convert(convert::ConvertArgs),
+    /// Compute a mesh's descriptors and band table and export them (.npy or .csv).
+    Features(features::FeaturesArgs),
+    /// Generate a synthetic shape family with ground-truth part labels.
+    Generate(generate::GenerateArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
@@ -32,6 +38,8 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         Command::Info(args) => info::run(args),
         Command::Convert(args) => convert::run(args),
+        Command::Features(args) => features::run(args),
+        Command::Generate(args) => generate::run(args),
     }
 }
 

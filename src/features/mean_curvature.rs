@@ -4,9 +4,12 @@ use crate::spectral::cotan_laplacian;
 /// Pointwise mean curvature `H` (length `d`, units 1/file length) from the cotangent Laplacian
 /// of the vertex positions.
 ///
-/// With the positive semi-definite weak Laplacian `L` and lumped mass `M`,
-/// `M⁻¹ L X ≈ −Δ X = 2 H n`; `H(v) = ⟨(M⁻¹ L X)_v, n_v⟩ / 2` where `n_v` is the
-/// area-weighted vertex normal (outward for counter-clockwise faces). Sign: `H = +1/r` on a
+/// With the positive semi-definite weak Laplacian `L` and a diagonal mass `A`,
+/// `A⁻¹ L X ≈ −Δ X = 2 H n`; `H(v) = ⟨(A⁻¹ L X)_v, n_v⟩ / 2` where `n_v` is the
+/// area-weighted vertex normal (outward for counter-clockwise faces). `A` is the *mixed Voronoi*
+/// area of Meyer et al. (2003) rather than the barycentric lumped mass: with barycentric areas
+/// the pointwise estimate does not converge at irregular vertices (e.g. 15 % too large at the
+/// valence-5 vertices of an icosphere, at any resolution); with mixed areas it does. Sign: `H = +1/r` on a
 /// sphere of radius `r` with outward normals, positive on convex bumps, negative in saddles'
 /// concave directions. Vertices with zero area or no normal get 0.
 ///
@@ -34,7 +37,7 @@ pub fn mean_curvature(mesh: &TriMesh) -> Vec<f64> {
             }
         }
     }
-    let mass = mesh.vertex_areas();
+    let mass = mixed_voronoi_areas(mesh);
     let normals = mesh.vertex_normals();
     (0..d)
         .map(|v| {
@@ -47,4 +50,47 @@ pub fn mean_curvature(mesh: &TriMesh) -> Vec<f64> {
             }
         })
         .collect()
+}
+
+/// Mixed Voronoi vertex areas (Meyer, Desbrun, Schröder, Barr 2003): the Voronoi area inside
+/// non-obtuse triangles, half/quarter of the triangle area at/beside an obtuse angle. Sums to the
+/// total area.
+fn mixed_voronoi_areas(mesh: &TriMesh) -> Vec<f64> {
+    let mut a = vec![0.0; mesh.vertex_count()];
+    for (f, idx) in mesh.faces().iter().enumerate() {
+        let p = mesh.corners(f);
+        let e = |i: usize, j: usize| [p[j][0] - p[i][0], p[j][1] - p[i][1], p[j][2] - p[i][2]];
+        let dot = |u: [f64; 3], v: [f64; 3]| u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+        let (ab, ac, bc) = (e(0, 1), e(0, 2), e(1, 2));
+        let cr = [
+            ab[1] * ac[2] - ab[2] * ac[1],
+            ab[2] * ac[0] - ab[0] * ac[2],
+            ab[0] * ac[1] - ab[1] * ac[0],
+        ];
+        let twice = dot(cr, cr).sqrt();
+        if twice <= 0.0 {
+            continue;
+        }
+        let area = 0.5 * twice;
+        // Dot products at each corner (cosine sign = obtuse test).
+        let d = [
+            dot(ab, ac),
+            dot([-ab[0], -ab[1], -ab[2]], bc),
+            dot([-ac[0], -ac[1], -ac[2]], [-bc[0], -bc[1], -bc[2]]),
+        ];
+        if let Some(obtuse) = d.iter().position(|&x| x < 0.0) {
+            for (k, &v) in idx.iter().enumerate() {
+                a[v as usize] += if k == obtuse { area / 2.0 } else { area / 4.0 };
+            }
+        } else {
+            // cot of the angle at corner k = d[k] / twice.
+            let len2 = [dot(bc, bc), dot(ac, ac), dot(ab, ab)]; // edge opposite corner k
+            for k in 0..3 {
+                let (i, j) = ((k + 1) % 3, (k + 2) % 3);
+                // Vertex k's Voronoi share: edges (k,i) and (k,j), opposite corners j and i.
+                a[idx[k] as usize] += (len2[j] * d[j] / twice + len2[i] * d[i] / twice) / 8.0;
+            }
+        }
+    }
+    a
 }

@@ -220,7 +220,7 @@ impl TriMesh {
         }
         let mesh = TriMesh { positions, faces };
         let area = mesh.total_area();
-        if !(area > 0.0) || !area.is_finite() {
+        if area <= 0.0 || !area.is_finite() {
             return Err(MeshError::ZeroArea { path, area });
         }
         Ok(mesh)

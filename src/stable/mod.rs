@@ -1,11 +1,31 @@
 //! Stable region pairs between two shapes: thresholding functions and Algorithms 1–3 of the
 //! paper (DESIGN §4), on the never-dense affinity operator of [`crate::affinity`].
+//!
+//! - [`threshold`]: `P_p`, `P_α`, `P[τ_t]` on a remaining subset.
+//! - [`stable_pair`]: Algorithm 1 (stable pair from an initial indicator).
+//! - [`stable_pairs_fixed`]: Algorithm 2 (fixed thresholds).
+//! - [`stable_pairs_auto`]: Algorithm 3 (automatic thresholds).
+//! - [`stable_regions`]: one call from two band tables.
+//! - [`correspondence_ratio`]: quality against a ground-truth map (paper §7.2).
 
+mod correspondence_ratio;
+mod initial_indicator;
 mod stable_pair;
+mod stable_pairs_auto;
+mod stable_pairs_fixed;
+mod stable_regions;
 mod threshold;
 
+pub use correspondence_ratio::{VertexMap, correspondence_ratio};
+pub use initial_indicator::{Init, initial_indicator};
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
+};
+pub use stable_pairs_auto::stable_pairs_auto;
+pub use stable_pairs_fixed::stable_pairs_fixed;
+pub use stable_regions::{
+    Algorithm, AreaReference, AutoThreshold, RegionPair, StableRegions, StableRegionsOptions,
+    stable_regions,
 };
 pub use threshold::{Threshold, threshold};
 
@@ -38,7 +58,7 @@ pub enum StableError {
     /// An option is out of range.
     #[error("invalid option: {0}")]
     BadOption(String),
-    /// A ground-truth map is malformed.
+    /// A ground-truth map is malformed or unreadable (names the file when there is one).
     #[error("ground-truth map: {0}")]
     BadMap(String),
 }

@@ -1,5 +1,8 @@
 //! Shared test fixtures, one file per area.
 #![allow(dead_code)]
 
+pub mod features;
+pub mod generate;
 pub mod graph;
+pub mod mesh;
 pub mod stable;

@@ -21,15 +21,15 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
         if e.kind() == ErrorKind::UnexpectedEof {
             truncated(format!("the file ends inside the PLY header ({e})"))
         } else {
-            header_error(format!("wrong header: {e}"))
+            header_error(format!("wrong header: {}", one_line(&e.to_string())))
         }
     })?;
     let index_name = check_header(&header)?;
     let payload = parser.read_payload(&mut reader, &header).map_err(|e| {
         if e.kind() == ErrorKind::UnexpectedEof {
-            truncated(e)
+            truncated(one_line(&e.to_string()))
         } else {
-            parse_error(None, e)
+            parse_error(None, one_line(&e.to_string()))
         }
     })?;
     let empty = Vec::new();
@@ -129,6 +129,21 @@ fn check_header(header: &Header) -> Result<&'static str, MeshError> {
     Err(header_error(
         "unsupported PLY: the `face` element has no `vertex_indices` or `vertex_index` list",
     ))
+}
+
+/// ply-rs-bw's messages span several lines and start with `Line N:`; make them one line, with
+/// the line number in our lower-case style.
+fn one_line(message: &str) -> String {
+    let flat = message
+        .split(['\n', '\t'])
+        .map(str::trim)
+        .filter(|s| !s.is_empty())
+        .collect::<Vec<_>>()
+        .join(" ");
+    match flat.strip_prefix("Line ") {
+        Some(rest) => format!("line {rest}"),
+        None => flat,
+    }
 }
 
 fn scalar_f64(p: &Property) -> Option<f64> {

@@ -1,0 +1,105 @@
+use anyhow::{Context, Result};
+use clap::{Args, ValueEnum};
+use coseg::bands::BandWeighting;
+use coseg::cache::{CacheOutcome, ShapePipelineOptions, compute_shape_data, load_or_compute};
+use coseg::features::{ExportFormat, ExportOptions, export_features};
+use coseg::mesh::read_mesh_with_report;
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum Format {
+    Npy,
+    Csv,
+}
+
+#[derive(Debug, Args)]
+pub struct FeaturesArgs {
+    /// Mesh file (.obj, .off, .ply).
+    mesh: PathBuf,
+    /// Output directory (created if missing).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// File format of the tables.
+    #[arg(long, value_enum, default_value = "npy")]
+    format: Format,
+    /// Also write the unit-area spectrum (eigenvalues, eigenvectors, vertex areas).
+    #[arg(long)]
+    spectrum: bool,
+    /// Number of Laplace–Beltrami eigenpairs.
+    #[arg(long, default_value_t = 200)]
+    eigenpairs: usize,
+    /// Number of HKS features.
+    #[arg(long, default_value_t = 100)]
+    hks: usize,
+    /// Number of WKS features.
+    #[arg(long, default_value_t = 100)]
+    wks: usize,
+    /// Number of multiscale mean-curvature features.
+    #[arg(long, default_value_t = 100)]
+    curvature: usize,
+    /// Number of bands K.
+    #[arg(long, default_value_t = 20)]
+    bands: usize,
+    /// Cut bands by equal area instead of equal vertex count.
+    #[arg(long)]
+    area_bands: bool,
+    /// Per-shape cache directory (read if valid, written otherwise).
+    #[arg(long)]
+    cache: Option<PathBuf>,
+}
+
+pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
+    let (mesh, report) = read_mesh_with_report(&args.mesh)?;
+    for w in &report.warnings {
+        eprintln!("warning: {}: {w}", args.mesh.display());
+    }
+    let mut opts = ShapePipelineOptions::default();
+    opts.spectrum.eigenpairs = args.eigenpairs;
+    opts.descriptors.hks_count = args.hks;
+    opts.descriptors.wks_count = args.wks;
+    opts.descriptors.curvature_count = args.curvature;
+    opts.bands.bands = args.bands;
+    if args.area_bands {
+        opts.bands.weighting = BandWeighting::Area;
+    }
+    let data = match &args.cache {
+        Some(dir) => {
+            let r = load_or_compute(&mesh, &opts, dir)
+                .with_context(|| format!("{}", args.mesh.display()))?;
+            match &r.outcome {
+                CacheOutcome::Hit => eprintln!("cache hit: {}", r.path.display()),
+                CacheOutcome::Miss => eprintln!("cache miss: wrote {}", r.path.display()),
+                CacheOutcome::Recomputed { reason } => eprintln!("warning: {reason}"),
+            }
+            if let Some(e) = &r.write_error {
+                eprintln!("warning: {e}");
+            }
+            r.data
+        }
+        None => {
+            compute_shape_data(&mesh, &opts).with_context(|| format!("{}", args.mesh.display()))?
+        }
+    };
+    let format = match args.format {
+        Format::Npy => ExportFormat::Npy,
+        Format::Csv => ExportFormat::Csv,
+    };
+    let written = export_features(
+        &args.output,
+        &data.descriptors,
+        &data.bands,
+        args.spectrum.then_some(&data.spectrum),
+        &ExportOptions { format },
+    )?;
+    println!(
+        "{}: {} vertices, {} features, {} bands -> {} files in {}",
+        args.mesh.display(),
+        data.vertices,
+        data.descriptors.feature_count(),
+        data.bands.bands,
+        written.len(),
+        args.output.display()
+    );
+    Ok(ExitCode::SUCCESS)
+}

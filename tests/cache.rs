@@ -1,0 +1,179 @@
+//! Tests of the per-shape cache: hits, misses, corrupt/truncated/stale entries, keys,
+//! determinism.
+
+mod common;
+
+use common::features::{blob, permutation, permute_mesh};
+use coseg::cache::{
+    CacheOutcome, ShapePipelineOptions, cache_path, compute_shape_data, encode_entry,
+    load_or_compute, mesh_hash, shape_key,
+};
+use coseg::mesh::TriMesh;
+
+fn opts() -> ShapePipelineOptions {
+    let mut o = ShapePipelineOptions::default();
+    o.spectrum.eigenpairs = 20;
+    o.descriptors.hks_count = 6;
+    o.descriptors.wks_count = 6;
+    o.descriptors.curvature_count = 6;
+    o.bands.bands = 8;
+    o
+}
+
+fn mesh() -> TriMesh {
+    blob(2)
+}
+
+fn is_recomputed(o: &CacheOutcome, needle: &str) -> bool {
+    matches!(o, CacheOutcome::Recomputed { reason } if reason.contains(needle))
+}
+
+#[test]
+fn miss_then_hit_with_identical_data() {
+    let dir = tempfile::tempdir().unwrap();
+    let (m, o) = (mesh(), opts());
+    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    assert_eq!(first.outcome, CacheOutcome::Miss);
+    assert!(first.write_error.is_none());
+    assert!(first.path.exists());
+    let second = load_or_compute(&m, &o, dir.path()).unwrap();
+    assert_eq!(second.outcome, CacheOutcome::Hit);
+    assert_eq!(first.data, second.data);
+    assert_eq!(first.data.key, shape_key(&m, &o));
+    // Nothing but the entry is left in the directory (no temporary files).
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
+}
+
+#[test]
+fn computation_is_bitwise_reproducible() {
+    let (m, o) = (mesh(), opts());
+    let a = compute_shape_data(&m, &o).unwrap();
+    let b = compute_shape_data(&m, &o).unwrap();
+    assert_eq!(encode_entry(&a), encode_entry(&b));
+}
+
+#[test]
+fn every_flipped_payload_byte_region_and_truncation_is_detected() {
+    let dir = tempfile::tempdir().unwrap();
+    let (m, o) = (mesh(), opts());
+    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    let good = std::fs::read(&first.path).unwrap();
+    // Positions across header and payload.
+    let len = good.len();
+    let cases: Vec<(usize, &str)> = vec![
+        (0, "magic"),
+        (9, "version"),
+        (20, "key"),
+        (45, "payload is"),
+        (60, "checksum"),
+        (100, "checksum"),
+        (len / 2, "checksum"),
+        (len - 1, "checksum"),
+    ];
+    for (pos, needle) in cases {
+        let mut bad = good.clone();
+        bad[pos] ^= 0x40;
+        std::fs::write(&first.path, &bad).unwrap();
+        let r = load_or_compute(&m, &o, dir.path()).unwrap();
+        assert!(
+            is_recomputed(&r.outcome, needle),
+            "byte {pos}: {:?}",
+            r.outcome
+        );
+        assert_eq!(r.data, first.data);
+        // The entry was rewritten and is trusted again.
+        assert_eq!(std::fs::read(&first.path).unwrap(), good);
+    }
+    for cut in [0, 10, 83, 84, len / 3, len - 1] {
+        std::fs::write(&first.path, &good[..cut]).unwrap();
+        let r = load_or_compute(&m, &o, dir.path()).unwrap();
+        assert!(
+            matches!(r.outcome, CacheOutcome::Recomputed { .. }),
+            "cut {cut}: {:?}",
+            r.outcome
+        );
+        assert_eq!(r.data, first.data);
+        assert_eq!(
+            load_or_compute(&m, &o, dir.path()).unwrap().outcome,
+            CacheOutcome::Hit
+        );
+    }
+    // Extra trailing bytes.
+    let mut long = good.clone();
+    long.push(0);
+    std::fs::write(&first.path, &long).unwrap();
+    assert!(is_recomputed(
+        &load_or_compute(&m, &o, dir.path()).unwrap().outcome,
+        "payload is"
+    ));
+}
+
+#[test]
+fn a_changed_option_or_mesh_gets_another_entry() {
+    let dir = tempfile::tempdir().unwrap();
+    let (m, o) = (mesh(), opts());
+    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    let mut o2 = o.clone();
+    o2.bands.bands = 5;
+    let second = load_or_compute(&m, &o2, dir.path()).unwrap();
+    assert_eq!(second.outcome, CacheOutcome::Miss);
+    assert_ne!(second.path, first.path);
+    assert_eq!(second.data.bands.bands, 5);
+    assert_eq!(second.data.spectrum, first.data.spectrum);
+    // Every option field takes part in the key.
+    let base = shape_key(&m, &o);
+    let mut v = Vec::new();
+    let mut x = o.clone();
+    x.spectrum.eigenpairs += 1;
+    v.push(x);
+    let mut x = o.clone();
+    x.descriptors.wks_sigma_multiple = 6.0;
+    v.push(x);
+    let mut x = o.clone();
+    x.descriptors.zero_eigenvalue = 1e-6;
+    v.push(x);
+    let mut x = o.clone();
+    x.descriptors.band = coseg::features::SpectralBand::Fixed {
+        lambda_min: 10.0,
+        lambda_max: 1000.0,
+    };
+    v.push(x);
+    let mut x = o.clone();
+    x.bands.weighting = coseg::bands::BandWeighting::Area;
+    v.push(x);
+    for x in &v {
+        assert_ne!(shape_key(&m, x), base);
+    }
+    // The mesh content, including vertex order, takes part too.
+    let moved = m.map_positions(|p| [p[0], p[1], p[2] + 1e-12]).unwrap();
+    assert_ne!(mesh_hash(&moved), mesh_hash(&m));
+    let permuted = permute_mesh(&m, &permutation(m.vertex_count(), 1));
+    assert_ne!(mesh_hash(&permuted), mesh_hash(&m));
+}
+
+#[test]
+fn an_entry_stored_under_the_wrong_key_is_stale() {
+    let dir = tempfile::tempdir().unwrap();
+    let (m, o) = (mesh(), opts());
+    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    let mut o2 = o.clone();
+    o2.descriptors.hks_count = 3;
+    // Someone copies the old entry to the new key's name: the header's key gives it away.
+    let target = cache_path(dir.path(), &shape_key(&m, &o2));
+    std::fs::copy(&first.path, &target).unwrap();
+    let r = load_or_compute(&m, &o2, dir.path()).unwrap();
+    assert!(is_recomputed(&r.outcome, "stale"), "{:?}", r.outcome);
+    assert_eq!(r.data.descriptors.hks_times.len(), 3);
+    assert_eq!(
+        load_or_compute(&m, &o2, dir.path()).unwrap().outcome,
+        CacheOutcome::Hit
+    );
+}
+
+#[test]
+fn a_file_in_place_of_the_directory_is_an_error_not_a_panic() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("not-a-dir");
+    std::fs::write(&file, b"x").unwrap();
+    assert!(load_or_compute(&mesh(), &opts(), &file).is_err());
+}

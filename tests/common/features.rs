@@ -1,0 +1,156 @@
+//! Fixtures for the features, bands and cache tests: icospheres, a smooth asymmetric blob, rigid
+//! motions and vertex permutations.
+#![allow(dead_code)]
+
+use coseg::mesh::TriMesh;
+use std::collections::HashMap;
+
+/// Unit icosphere: an icosahedron subdivided `level` times, vertices projected on the unit
+/// sphere (10·4^level + 2 vertices), counter-clockwise seen from outside.
+pub fn icosphere(level: usize) -> TriMesh {
+    let t = (1.0 + 5f64.sqrt()) / 2.0;
+    let mut pos: Vec<[f64; 3]> = vec![
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
+    ];
+    let mut faces: Vec<[u32; 3]> = vec![
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let unit = |p: [f64; 3]| {
+        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
+        [p[0] / n, p[1] / n, p[2] / n]
+    };
+    for p in pos.iter_mut() {
+        *p = unit(*p);
+    }
+    for _ in 0..level {
+        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut next = Vec::with_capacity(faces.len() * 4);
+        let mut midpoint = |a: u32, b: u32, pos: &mut Vec<[f64; 3]>| -> u32 {
+            let k = (a.min(b), a.max(b));
+            *mid.entry(k).or_insert_with(|| {
+                let (p, q) = (pos[a as usize], pos[b as usize]);
+                pos.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
+                (pos.len() - 1) as u32
+            })
+        };
+        for &[a, b, c] in &faces {
+            let ab = midpoint(a, b, &mut pos);
+            let bc = midpoint(b, c, &mut pos);
+            let ca = midpoint(c, a, &mut pos);
+            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
+        }
+        faces = next;
+    }
+    TriMesh::new(pos, faces).unwrap()
+}
+
+/// A smooth, star-shaped, asymmetric blob (no symmetry, so generic simple eigenvalues and no
+/// feature ties): the icosphere with radius `1 + bumps(direction)`.
+pub fn blob(level: usize) -> TriMesh {
+    icosphere(level)
+        .map_positions(|p| {
+            let r = 1.0
+                + 0.35 * (2.0 * p[0] + 0.3).sin() * (1.5 * p[1] - 0.2).cos()
+                + 0.25 * (3.0 * p[2] + 0.7 * p[0]).sin()
+                + 0.6 * (p[0] - 0.5).max(0.0).powi(2);
+            [r * p[0] * 1.3, r * p[1], r * p[2] * 0.8]
+        })
+        .unwrap()
+}
+
+/// A rotation (about an oblique axis), uniform scaling by `scale` and translation.
+pub fn similarity(mesh: &TriMesh, scale: f64) -> TriMesh {
+    let (a, b) = (0.7f64, -1.1f64);
+    let (ca, sa, cb, sb) = (a.cos(), a.sin(), b.cos(), b.sin());
+    mesh.map_positions(|p| {
+        // Rotate about z by a, then about x by b.
+        let q = [ca * p[0] - sa * p[1], sa * p[0] + ca * p[1], p[2]];
+        let r = [q[0], cb * q[1] - sb * q[2], sb * q[1] + cb * q[2]];
+        [scale * r[0] + 3.0, scale * r[1] - 1.5, scale * r[2] + 0.25]
+    })
+    .unwrap()
+}
+
+/// A fixed pseudo-random permutation of `0..n` (`perm[new] = old`), seeded.
+pub fn permutation(n: usize, seed: u64) -> Vec<usize> {
+    let mut p: Vec<usize> = (0..n).collect();
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
+    for i in (1..n).rev() {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        let j = ((s >> 33) % (i as u64 + 1)) as usize;
+        p.swap(i, j);
+    }
+    p
+}
+
+/// The mesh with its vertices reordered: new vertex `i` is old vertex `perm[i]`.
+pub fn permute_mesh(mesh: &TriMesh, perm: &[usize]) -> TriMesh {
+    let mut inv = vec![0u32; perm.len()];
+    for (new, &old) in perm.iter().enumerate() {
+        inv[old] = new as u32;
+    }
+    let pos = perm.iter().map(|&old| mesh.positions()[old]).collect();
+    let faces = mesh
+        .faces()
+        .iter()
+        .map(|f| [inv[f[0] as usize], inv[f[1] as usize], inv[f[2] as usize]])
+        .collect();
+    TriMesh::new(pos, faces).unwrap()
+}
+
+/// Ranks of `x` (0-based, ties by index).
+pub fn ranks(x: &[f64]) -> Vec<usize> {
+    let mut order: Vec<usize> = (0..x.len()).collect();
+    order.sort_by(|&a, &b| x[a].total_cmp(&x[b]).then(a.cmp(&b)));
+    let mut r = vec![0; x.len()];
+    for (i, &v) in order.iter().enumerate() {
+        r[v] = i;
+    }
+    r
+}
+
+/// Spearman rank correlation (no tie correction).
+pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
+    let (ra, rb) = (ranks(a), ranks(b));
+    let n = a.len() as f64;
+    let d2: f64 = ra
+        .iter()
+        .zip(&rb)
+        .map(|(&x, &y)| (x as f64 - y as f64).powi(2))
+        .sum();
+    1.0 - 6.0 * d2 / (n * (n * n - 1.0))
+}
