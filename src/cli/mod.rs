@@ -4,6 +4,7 @@ mod convert;
 mod features;
 mod generate;
 mod info;
+mod segment;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -31,6 +32,8 @@ enum Command {
     Features(features::FeaturesArgs),
     /// Generate a synthetic shape family with ground-truth part labels.
     Generate(generate::GenerateArgs),
+    /// Co-segment every mesh of a folder into corresponding regions (same id = same part).
+    Segment(segment::SegmentArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
@@ -40,6 +43,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Convert(args) => convert::run(args),
         Command::Features(args) => features::run(args),
         Command::Generate(args) => generate::run(args),
+        Command::Segment(args) => segment::run(args),
     }
 }
 
