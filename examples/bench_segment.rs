@@ -60,10 +60,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let data = shape_data_from_spectrum(m, s, &opts)?;
         t_feat += t.elapsed().as_secs_f64();
         let t = Instant::now();
-        std::fs::write(cache_path(&cache, &shape_key(m, &opts)), encode_entry(&data))?;
+        std::fs::write(
+            cache_path(&cache, &shape_key(m, &opts)),
+            encode_entry(&data),
+        )?;
         t_write += t.elapsed().as_secs_f64();
         let name = f.file_stem().unwrap().to_string_lossy().into_owned();
-        nodes.push(ShapeNode::new(name, data.bands, &data.descriptors.vertex_areas)?);
+        nodes.push(ShapeNode::new(
+            name,
+            data.bands,
+            &data.descriptors.vertex_areas,
+        )?);
     }
     let t = Instant::now();
     let graph = ShapeGraph::build(nodes, &GraphOptions::default())?;
@@ -85,7 +92,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             return Err(format!("{}: cache miss on the warm run", f.display()).into());
         }
         let name = f.file_stem().unwrap().to_string_lossy().into_owned();
-        nodes.push(ShapeNode::new(name, r.data.bands, &r.data.descriptors.vertex_areas)?);
+        nodes.push(ShapeNode::new(
+            name,
+            r.data.bands,
+            &r.data.descriptors.vertex_areas,
+        )?);
     }
     let t_load = t.elapsed().as_secs_f64();
     let t = Instant::now();

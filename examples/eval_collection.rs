@@ -64,7 +64,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         let mesh = read_mesh(f)?;
         let data = load_or_compute(&mesh, &opts, &cache)?.data;
         let name = f.file_stem().unwrap().to_string_lossy().into_owned();
-        nodes.push(ShapeNode::new(name, data.bands, &data.descriptors.vertex_areas)?);
+        nodes.push(ShapeNode::new(
+            name,
+            data.bands,
+            &data.descriptors.vertex_areas,
+        )?);
     }
     let d = nodes[0].bands.vertices;
     if nodes.iter().any(|n| n.bands.vertices != d) {
@@ -121,7 +125,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     };
     let mut chain: Vec<Vec<i32>> = Vec::new();
     for i in 0..nodes.len() - 1 {
-        let pr = stable_regions(&nodes[i].bands, &nodes[i + 1].bands, &areas[i], &areas[i + 1], &so)?;
+        let pr = stable_regions(
+            &nodes[i].bands,
+            &nodes[i + 1].bands,
+            &areas[i],
+            &areas[i + 1],
+            &so,
+        )?;
         if i == 0 {
             chain.push(pr.labels_a());
         }

@@ -2,7 +2,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::cache::{CacheOutcome, ShapePipelineOptions};
 use coseg::graph::{
-    Cosegmentation, CosegmentOptions, GraphKind, GraphOptions, LoadedCollection, ShapeGraph,
+    CosegmentOptions, Cosegmentation, GraphKind, GraphOptions, LoadedCollection, ShapeGraph,
     cosegment, load_collection,
 };
 use coseg::mesh::{PlyVertexProperty, write_mesh};
@@ -42,7 +42,10 @@ pub struct SegmentArgs {
 }
 
 pub fn run(args: SegmentArgs) -> Result<ExitCode> {
-    let cache = args.cache.clone().unwrap_or_else(|| args.out.join(".cache"));
+    let cache = args
+        .cache
+        .clone()
+        .unwrap_or_else(|| args.out.join(".cache"));
     let pipeline = ShapePipelineOptions::default();
     let t0 = Instant::now();
     let bar = if std::io::stderr().is_terminal() {
@@ -74,7 +77,10 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
     }
     let total_files = loaded.nodes.len() + loaded.skipped.len();
     if total_files == 0 {
-        bail!("{}: no mesh files (.obj, .off, .ply)", args.folder.display());
+        bail!(
+            "{}: no mesh files (.obj, .off, .ply)",
+            args.folder.display()
+        );
     }
     if loaded.nodes.len() < 2 {
         bail!(
