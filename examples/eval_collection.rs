@@ -2,7 +2,7 @@
 //! pairwise baseline.
 //!
 //! ```text
-//! cargo run --release --example eval_collection -- [--cache DIR] [--regions K] [--alpha A] MESH...
+//! cargo run --release --example eval_collection -- [--cache DIR] [--regions K] [--alpha A] [--complete-limit N] MESH...
 //! ```
 //! Every mesh must have the same vertex count (shapes of one class whose vertex `i` corresponds
 //! to vertex `i` everywhere, e.g. TOSCA's cats or FAUST). Prints, for the co-segmentation and for
@@ -45,11 +45,15 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut cache = PathBuf::from("/tmp/coseg-eval-cache");
     let mut regions = CosegmentOptions::default().regions;
     let mut alpha: Option<f64> = None;
+    let mut graph_opts = GraphOptions::default();
     let mut files = Vec::new();
     while let Some(a) = args.next() {
         match a.as_str() {
             "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),
             "--regions" => regions = args.next().ok_or("--regions K")?.parse()?,
+            "--complete-limit" => {
+                graph_opts.complete_limit = args.next().ok_or("--complete-limit N")?.parse()?
+            }
             "--alpha" => alpha = Some(args.next().ok_or("--alpha A")?.parse()?),
             _ => files.push(PathBuf::from(a)),
         }
@@ -78,7 +82,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let areas: Vec<Vec<f64>> = nodes.iter().map(|n| n.areas.clone()).collect();
 
     let t = Instant::now();
-    let graph = ShapeGraph::build(nodes.clone(), &GraphOptions::default())?;
+    let graph = ShapeGraph::build(nodes.clone(), &graph_opts)?;
     let co = CosegmentOptions {
         regions,
         area_fraction: alpha,
