@@ -758,8 +758,9 @@ proptest! {
         which in 0usize..5,
         edits in proptest::collection::vec(edit(), 1..6),
     ) {
-        let samples = valid_samples();
-        let (fmt, mut bytes) = samples[which].clone();
+        static SAMPLES: std::sync::OnceLock<Vec<(MeshFormat, Vec<u8>)>> =
+            std::sync::OnceLock::new();
+        let (fmt, mut bytes) = SAMPLES.get_or_init(valid_samples)[which].clone();
         apply(&mut bytes, &edits);
         // Any format's parser on any mutated file: none may panic.
         let _ = read_mesh_from_bytes(&bytes, fmt);
@@ -837,4 +838,40 @@ fn shared_data_loads_with_header_counts_and_round_trips() {
         round_trip_all(&mesh, dir.path());
     }
     eprintln!("checked {} files", files.len());
+}
+
+#[test]
+fn huge_declared_counts_fail_cleanly_without_allocating_them() {
+    let off = "OFF\n4000000000 4000000000 0\n0 0 0\n";
+    let err = read_mesh_from_bytes(off.as_bytes(), MeshFormat::Off).unwrap_err();
+    assert!(matches!(err, MeshError::Truncated { .. }), "{err:?}");
+    let off = "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n4000000000 0 1 2\n";
+    let err = read_mesh_from_bytes(off.as_bytes(), MeshFormat::Off).unwrap_err();
+    assert!(matches!(err, MeshError::Parse { .. }), "{err:?}");
+    for count in ["uint", "int"] {
+        let mut ply = format!(
+            "ply\nformat binary_little_endian 1.0\nelement vertex 3000000000\nproperty double x\nproperty double y\nproperty double z\nelement face 1\nproperty list {count} int vertex_indices\nend_header\n"
+        )
+        .into_bytes();
+        ply.extend_from_slice(&[0u8; 72]);
+        let err = read_mesh_from_bytes(&ply, MeshFormat::Ply).unwrap_err();
+        assert!(matches!(err, MeshError::Truncated { .. }), "{err:?}");
+        // A face list declaring 4 294 967 295 (or -1) entries.
+        let mut ply = format!(
+            "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty double x\nproperty double y\nproperty double z\nelement face 1\nproperty list {count} int vertex_indices\nend_header\n"
+        )
+        .into_bytes();
+        for p in [[0.0f64, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]] {
+            for c in p {
+                ply.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        ply.extend_from_slice(&u32::MAX.to_le_bytes());
+        ply.extend_from_slice(&[0u8; 12]);
+        let err = read_mesh_from_bytes(&ply, MeshFormat::Ply).unwrap_err();
+        assert!(
+            matches!(err, MeshError::Truncated { .. } | MeshError::Parse { .. }),
+            "{err:?}"
+        );
+    }
 }

@@ -65,7 +65,7 @@ pub enum MeshError {
         path: String,
         /// Face number (0-based, after triangulation).
         face: usize,
-        /// The offending index.
+        /// The offending index, 0-based (an OBJ file's 1-based `k` is reported as `k - 1`).
         index: u64,
         /// Number of vertices.
         vertices: usize,

@@ -23,7 +23,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut positions: Vec<[f64; 3]> = Vec::new();
     // Faces as signed 1-based indices resolved now (negative ones are relative to the vertices
     // read so far); range-checked at the end since a face may name a later vertex.
-    let mut polys: Vec<(usize, Vec<i64>)> = Vec::new();
+    let mut polys: Vec<Vec<i64>> = Vec::new();
     let mut joined = String::new();
     while let Some(raw) = lines.next_raw()? {
         let line = lines.line();
@@ -108,7 +108,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
                         format!("face has {} vertices, at least 3 are needed", poly.len()),
                     ));
                 }
-                polys.push((line, poly));
+                polys.push(poly);
             }
             _ => {}
         }
@@ -116,7 +116,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let nv = positions.len();
     let mut faces = Vec::with_capacity(polys.len());
     let mut poly32: Vec<u32> = Vec::new();
-    for (_, poly) in &polys {
+    for poly in &polys {
         poly32.clear();
         for &i in poly {
             // i >= 0 here.
