@@ -6,6 +6,7 @@ mod generate;
 mod info;
 mod spectrum;
 mod pair;
+mod segment;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;
@@ -37,6 +38,8 @@ enum Command {
     Generate(generate::GenerateArgs),
     /// Stable region correspondences between two meshes (Algorithm 2 or 3).
     Pair(pair::PairArgs),
+    /// Co-segment every mesh of a folder into corresponding regions (same id = same part).
+    Segment(segment::SegmentArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
@@ -48,6 +51,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Features(args) => features::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Pair(args) => pair::run(args),
+        Command::Segment(args) => segment::run(args),
     }
 }
 

@@ -1,1 +1,57 @@
-//! Placeholder: filled in by its issue.
+//! Shape collections: the shape graph, the cycle solver and consistent co-segmentation of a
+//! whole collection (DESIGN §5).
+//!
+//! - [`stable_cycle`]: fixed points of `P_0 ∘ W_{0,m−1} ∘ … ∘ P_1 ∘ W_10` around a cycle of any
+//!   length `m ≥ 2`; the 2-cycle is exactly Algorithm 1.
+//! - [`cycle_consistency`]: how much of a region carried around a cycle of thresholded
+//!   transports comes back to itself.
+//! - [`ShapeGraph`]: nodes hold each shape's band table and unit-area vertex areas, edges the
+//!   feature pairing and a weight; pairwise affinities exist only as band-table operators.
+//! - [`cosegment`]: consistent region tuples across every shape of the graph (design argued
+//!   in that function's module).
+//! - [`load_collection`]: a folder of meshes to graph nodes through the per-shape cache.
+
+mod cosegment;
+mod cycle_consistency;
+mod load_collection;
+mod shape_graph;
+mod stable_cycle;
+
+pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
+pub use cycle_consistency::{CycleConsistency, cycle_consistency};
+pub use load_collection::{LoadedCollection, SkippedFile, load_collection, mesh_files};
+pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
+pub use stable_cycle::{
+    CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
+};
+
+use crate::affinity::AffinityError;
+use thiserror::Error;
+
+/// Errors of the collection stage.
+#[derive(Debug, Error)]
+pub enum GraphError {
+    /// An affinity operator rejected its input.
+    #[error(transparent)]
+    Affinity(#[from] AffinityError),
+    /// An option or argument is out of range.
+    #[error("invalid option: {0}")]
+    BadOption(String),
+    /// Shapes that must share a band count or feature count do not.
+    #[error("shape {name}: {reason}")]
+    Incompatible {
+        /// The shape's name.
+        name: String,
+        /// What does not match.
+        reason: String,
+    },
+    /// The collection folder could not be listed.
+    #[error("{path}: {source}")]
+    Io {
+        /// The folder.
+        path: String,
+        /// The I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+}

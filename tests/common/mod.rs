@@ -3,6 +3,7 @@
 
 pub mod features;
 pub mod generate;
+pub mod graph;
 pub mod mesh;
 pub mod stable;
 pub mod shapes;

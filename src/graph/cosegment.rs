@@ -1,0 +1,748 @@
+//! [`cosegment`]: consistent region tuples across every shape of a [`ShapeGraph`].
+//!
+//! # Design
+//! A region tuple `(f_1, …, f_n)` (one indicator per shape) is *graph-stable* when every shape's
+//! region is what its neighbours, transported onto it, select:
+//!
+//! `f_i = P_i( Σ_{j ~ i} w_ij · W_ij f_j / (N_ij |f_j|) )`  for every shape `i`,
+//!
+//! with `W_ij f_j` the raw band-match counts of the edge operator (so `W_ij f_j / (N_ij |f_j|)`
+//! is, per vertex of `i`, the mean fraction of features whose bands agree with `f_j`'s vertices:
+//! a score in `[0, 1]` whatever the region's size), `w_ij` the edge weight and `P_i` the area
+//! rule `P_α` on the remaining vertices of shape `i` (`α` a fraction of the shape's total area,
+//! so every region has the same size on every shape, as the paper's "10 % cutoff").
+//!
+//! This is the simultaneous update of DESIGN §5. We solve it by Gauss–Seidel sweeps in the
+//! breadth-first order of a spanning tree rooted at the most central shape, always using the
+//! newest regions, until a whole sweep changes nothing. Why this design rather than covering the
+//! graph with cycles:
+//! - On two shapes it *is* Algorithm 1 (after the start): shape 1 gets `P_1(W_10 f_0)`, shape 0
+//!   gets `P_0(W_01 f_1)` — positive scalings of the scores do not change a threshold. On a
+//!   3-cycle it is the cycle solver's update with every shape also hearing its other neighbour,
+//!   i.e. the consistency that cycles sharing shapes must agree on is imposed directly.
+//! - A fixed point is consistent everywhere at once; there is no choice of cycle basis and no
+//!   reconciliation step where cycles overlap.
+//! - One sweep costs one histogram scatter per changed region (`O(N |f_j|)`), one `N × K`
+//!   mix per edge, and one gather over each shape's remaining vertices (`O(N d_i)`): it scales
+//!   with the number of shapes, not with the number of cycles.
+//! - The stop test is exact: when a sweep changes nothing, every `f_i` was recomputed from the
+//!   final neighbours, so the tuple satisfies the equations above simultaneously
+//!   ([`cosegment_update`] checks it). A guard as in Algorithm 1: a sweep cap and cycle
+//!   detection (a tuple seen before); then the visited tuple of highest objective
+//!   `Σ_i Σ_{q ∈ f_i} score_i(q)` is kept and reported as not converged.
+//!
+//! Start of each tuple: a seed on the root shape (by default its remaining vertex with the most
+//! extreme band labels, `argmax_p Σ_k |2 band[k][p] − (K − 1)|`, a distinctive point such as a
+//! limb tip; or a seeded random half of the remaining vertices, the paper's choice) is carried
+//! along the spanning tree (`f_child = P_child(W f_parent)`), which gives every shape a start
+//! consistent with the root's; the sweeps then settle the tuple.
+//!
+//! As Algorithms 2 and 3 do for pairs, each found tuple is removed from every shape and the next
+//! is sought on the remainder; after `regions − 1` tuples, the leftovers form the last region.
+//! Region `r` means the same part on every shape.
+//!
+//! Confidence of a tuple: the mean, over the spanning-tree edges in both directions, of the
+//! area IoU between `f_i` and `P_p(W_ij f_j)` (the neighbour's region carried alone, keeping
+//! as many vertices as `f_i` has); and separately the mean [`super::cycle_consistency`] IoU over a
+//! deterministic sample of the graph's triangles.
+
+use super::shape_graph::ShapeGraph;
+use super::stable_cycle::{CycleShape, CycleStep, intersect_sorted};
+use super::{GraphError, cycle_consistency};
+use crate::affinity::BandAffinity;
+use crate::stable::{Threshold, threshold};
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::{Rng, SeedableRng};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+
+/// Options of [`cosegment`].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct CosegmentOptions {
+    /// Number of regions per shape, the last being the leftovers (default 6).
+    pub regions: usize,
+    /// Area of each extracted region as a fraction of its shape's total area (default `None`:
+    /// `1 / regions`, so the leftovers are about as large as the others).
+    pub area_fraction: Option<f64>,
+    /// Root of the spanning tree (default `None`: the shape with the largest total edge weight,
+    /// ties by lowest index).
+    pub root: Option<usize>,
+    /// Sweep cap per tuple (default 100).
+    pub max_sweeps: usize,
+    /// `None` (default): each tuple starts from the root's most extreme remaining vertex.
+    /// `Some(s)`: from a random half of the root's remaining vertices (ChaCha8 seeded with `s`
+    /// and the tuple index).
+    pub seed: Option<u64>,
+    /// Triangles of the graph sampled for each tuple's cycle consistency (default 8; 0 skips).
+    pub triangles: usize,
+}
+
+impl Default for CosegmentOptions {
+    fn default() -> Self {
+        Self {
+            regions: 6,
+            area_fraction: None,
+            root: None,
+            max_sweeps: 100,
+            seed: None,
+            triangles: 8,
+        }
+    }
+}
+
+impl CosegmentOptions {
+    /// The area fraction actually used.
+    pub fn alpha(&self) -> f64 {
+        self.area_fraction
+            .unwrap_or(1.0 / self.regions.max(1) as f64)
+    }
+}
+
+/// One region per shape, the same part on every shape.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RegionTuple {
+    /// `regions[i]`: vertices of shape `i`, ascending.
+    pub regions: Vec<Vec<u32>>,
+    /// Area of each region over its shape's total area.
+    pub area_fractions: Vec<f64>,
+    /// Gauss–Seidel sweeps run (0 for the leftovers).
+    pub sweeps: usize,
+    /// Whether a sweep changed nothing (a fixed point); `true` for the leftovers.
+    pub converged: bool,
+    /// Whether the sweeps revisited a tuple (limit cycle).
+    pub cycled: bool,
+    /// `Σ_i Σ_{q ∈ f_i} score_i(q)` at the end (see the module docs).
+    pub objective: f64,
+    /// Mean area IoU between each region and its tree neighbour's region carried onto it
+    /// (both directions of every spanning-tree edge), in `[0, 1]`.
+    pub confidence: f64,
+    /// Mean area IoU of the region carried around sampled triangles of the graph
+    /// ([`super::cycle_consistency`], each step keeping as many vertices as the tuple's region
+    /// on that shape); `None` when the graph has no triangle or none sampled.
+    pub cycle_consistency: Option<f64>,
+    /// `true` for the last tuple, made of the leftovers.
+    pub leftover: bool,
+}
+
+/// The co-segmentation of a collection.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Cosegmentation {
+    /// Shape names, in graph order.
+    pub names: Vec<String>,
+    /// Vertex count of each shape.
+    pub vertices: Vec<usize>,
+    /// Root of the spanning tree.
+    pub root: usize,
+    /// Breadth-first order of the sweeps (starts with the root).
+    pub order: Vec<usize>,
+    /// Spanning-tree parent of each shape (`None` for the root).
+    pub parent: Vec<Option<usize>>,
+    /// The area fraction used per region.
+    pub alpha: f64,
+    /// The region tuples in extraction order; tuple `r` is region id `r` on every shape.
+    pub tuples: Vec<RegionTuple>,
+}
+
+impl Cosegmentation {
+    /// Region id of every vertex of shape `i` (`-1` for a vertex in no region, which does not
+    /// happen once the leftovers are assigned).
+    pub fn labels(&self, i: usize) -> Vec<i32> {
+        let mut out = vec![-1; self.vertices[i]];
+        for (r, t) in self.tuples.iter().enumerate() {
+            for &v in &t.regions[i] {
+                out[v as usize] = r as i32;
+            }
+        }
+        out
+    }
+
+    /// The vertices of shape `i` still remaining when tuple `r` was extracted (all vertices
+    /// minus the regions of tuples `0..r`), ascending.
+    pub fn remaining_before(&self, r: usize, i: usize) -> Vec<u32> {
+        let mut taken = vec![false; self.vertices[i]];
+        for t in &self.tuples[..r.min(self.tuples.len())] {
+            for &v in &t.regions[i] {
+                taken[v as usize] = true;
+            }
+        }
+        (0..self.vertices[i] as u32)
+            .filter(|&v| !taken[v as usize])
+            .collect()
+    }
+}
+
+/// Per-shape histograms and score tables: the engine of the sweeps.
+struct Engine<'g> {
+    graph: &'g ShapeGraph,
+    bands: usize,
+    /// `neighbours[i]`: `(j, edge weight, pairs as (k on j, k on i), raw pair weights)`.
+    neighbours: Vec<Vec<Neighbour>>,
+    /// Histogram of the current region of each shape (`N × K` counts).
+    hist: Vec<Vec<f64>>,
+    /// Size of the current region of each shape.
+    size: Vec<usize>,
+    table: Vec<f64>,
+    scratch: Vec<u32>,
+}
+
+struct Neighbour {
+    j: usize,
+    weight: f64,
+    pairs: Vec<(usize, usize)>,
+    raw: Vec<f64>,
+}
+
+impl<'g> Engine<'g> {
+    fn new(graph: &'g ShapeGraph) -> Self {
+        let n = graph.node_count();
+        let bands = graph.node(0).bands.bands;
+        let neighbours = (0..n)
+            .map(|i| {
+                graph
+                    .neighbours(i)
+                    .into_iter()
+                    .map(|(j, e)| {
+                        let np = e.pairs.len() as f64;
+                        let raw = match &e.pair_weights {
+                            Some(w) => {
+                                let s: f64 = w.iter().sum();
+                                w.iter().map(|x| x / s * np).collect()
+                            }
+                            None => vec![1.0; e.pairs.len()],
+                        };
+                        let pairs = e
+                            .pairs
+                            .iter()
+                            .map(|&(lo, hi)| {
+                                if j < i {
+                                    (lo as usize, hi as usize)
+                                } else {
+                                    (hi as usize, lo as usize)
+                                }
+                            })
+                            .collect();
+                        Neighbour {
+                            j,
+                            weight: e.weight,
+                            pairs,
+                            raw,
+                        }
+                    })
+                    .collect()
+            })
+            .collect();
+        let hist = (0..n)
+            .map(|i| vec![0.0; graph.node(i).bands.features * bands])
+            .collect();
+        Self {
+            graph,
+            bands,
+            neighbours,
+            hist,
+            size: vec![0; n],
+            table: Vec::new(),
+            scratch: Vec::new(),
+        }
+    }
+
+    fn set_region(&mut self, i: usize, region: &[u32]) {
+        let t = &self.graph.node(i).bands;
+        let k = self.bands;
+        let h = &mut self.hist[i];
+        h.fill(0.0);
+        for &p in region {
+            for (f, &l) in t.row(p as usize).iter().enumerate() {
+                h[f * k + l as usize] += 1.0;
+            }
+        }
+        self.size[i] = region.len();
+    }
+
+    /// Scores on the remaining vertices of `i` from the current regions of `sources` (all
+    /// neighbours when `None`).
+    fn scores(&mut self, i: usize, sources: Option<&[usize]>, rem: &[u32], out: &mut Vec<f64>) {
+        let t = &self.graph.node(i).bands;
+        let k = self.bands;
+        self.table.clear();
+        self.table.resize(t.features * k, 0.0);
+        for nb in &self.neighbours[i] {
+            if sources.is_some_and(|s| !s.contains(&nb.j)) || self.size[nb.j] == 0 {
+                continue;
+            }
+            let c = nb.weight / (nb.pairs.len() as f64 * self.size[nb.j] as f64);
+            let h = &self.hist[nb.j];
+            for (&(ka, kb), &r) in nb.pairs.iter().zip(&nb.raw) {
+                let cr = c * r;
+                for (dst, &src) in self.table[kb * k..(kb + 1) * k]
+                    .iter_mut()
+                    .zip(&h[ka * k..(ka + 1) * k])
+                {
+                    *dst += cr * src;
+                }
+            }
+        }
+        out.clear();
+        out.resize(rem.len(), 0.0);
+        let table = &self.table;
+        out.par_chunks_mut(512)
+            .zip(rem.par_chunks(512))
+            .for_each(|(o, idx)| {
+                for (s, &q) in o.iter_mut().zip(idx) {
+                    let row = t.row(q as usize);
+                    let mut acc = 0.0;
+                    for (f, &l) in row.iter().enumerate() {
+                        acc += table[f * k + l as usize];
+                    }
+                    *s = acc;
+                }
+            });
+    }
+
+    /// `P_α(scores)` on `rem` of shape `i`.
+    fn select(&mut self, i: usize, rem: &[u32], scores: &[f64], alpha: f64, out: &mut Vec<u32>) {
+        threshold(
+            Threshold::AreaFraction(alpha),
+            rem,
+            scores,
+            &self.graph.node(i).areas,
+            1.0,
+            out,
+            &mut self.scratch,
+        );
+    }
+}
+
+fn check(graph: &ShapeGraph, options: &CosegmentOptions) -> Result<(), GraphError> {
+    let n = graph.node_count();
+    if n < 2 {
+        return Err(GraphError::BadOption(format!(
+            "co-segmentation needs at least 2 shapes, got {n}"
+        )));
+    }
+    if !graph.is_connected() {
+        return Err(GraphError::BadOption(
+            "the shape graph is not connected".into(),
+        ));
+    }
+    if options.regions == 0 {
+        return Err(GraphError::BadOption("regions must be at least 1".into()));
+    }
+    let a = options.alpha();
+    if !(a.is_finite() && a > 0.0 && a <= 1.0) {
+        return Err(GraphError::BadOption(format!(
+            "area fraction {a} must be in (0, 1]"
+        )));
+    }
+    if options.max_sweeps == 0 {
+        return Err(GraphError::BadOption(
+            "max_sweeps must be at least 1".into(),
+        ));
+    }
+    if options.root.is_some_and(|r| r >= n) {
+        return Err(GraphError::BadOption(format!(
+            "root {} out of range ({n} shapes)",
+            options.root.unwrap_or(0)
+        )));
+    }
+    for i in 0..n {
+        if graph.node(i).bands.vertices == 0 {
+            return Err(GraphError::Incompatible {
+                name: graph.node(i).name.clone(),
+                reason: "no vertices".into(),
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Root and breadth-first spanning tree of the graph.
+fn spanning_tree(
+    graph: &ShapeGraph,
+    root: Option<usize>,
+) -> (usize, Vec<usize>, Vec<Option<usize>>) {
+    let n = graph.node_count();
+    let root = root.unwrap_or_else(|| {
+        let mut best = (f64::NEG_INFINITY, 0);
+        for i in 0..n {
+            let w: f64 = graph.neighbours(i).iter().map(|(_, e)| e.weight).sum();
+            if w > best.0 {
+                best = (w, i);
+            }
+        }
+        best.1
+    });
+    let mut parent = vec![None; n];
+    let mut seen = vec![false; n];
+    let mut order = Vec::with_capacity(n);
+    let mut queue = VecDeque::from([root]);
+    seen[root] = true;
+    while let Some(i) = queue.pop_front() {
+        order.push(i);
+        for (j, _) in graph.neighbours(i) {
+            if !seen[j] {
+                seen[j] = true;
+                parent[j] = Some(i);
+                queue.push_back(j);
+            }
+        }
+    }
+    (root, order, parent)
+}
+
+fn seed_region(
+    graph: &ShapeGraph,
+    root: usize,
+    rem: &[u32],
+    seed: Option<u64>,
+    index: usize,
+) -> Vec<u32> {
+    match seed {
+        None => {
+            let t = &graph.node(root).bands;
+            let k1 = t.bands as i64 - 1;
+            let mut best: Option<(i64, u32)> = None;
+            for &p in rem {
+                let s: i64 = t
+                    .row(p as usize)
+                    .iter()
+                    .map(|&l| (2 * l as i64 - k1).abs())
+                    .sum();
+                if best.is_none_or(|(bs, _)| s > bs) {
+                    best = Some((s, p));
+                }
+            }
+            best.map(|(_, p)| vec![p]).unwrap_or_default()
+        }
+        Some(s) => {
+            let mut rng = ChaCha8Rng::seed_from_u64(
+                s ^ (index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15),
+            );
+            let mut out = Vec::with_capacity(rem.len() / 2 + 1);
+            let mut bits = 0u64;
+            for (i, &v) in rem.iter().enumerate() {
+                if i % 64 == 0 {
+                    bits = rng.next_u64();
+                }
+                if (bits >> (i % 64)) & 1 == 1 {
+                    out.push(v);
+                }
+            }
+            out
+        }
+    }
+}
+
+fn remove_sorted(from: &mut Vec<u32>, remove: &[u32]) {
+    let mut j = 0;
+    from.retain(|&v| {
+        while j < remove.len() && remove[j] < v {
+            j += 1;
+        }
+        !(j < remove.len() && remove[j] == v)
+    });
+}
+
+fn area(areas: &[f64], v: &[u32]) -> f64 {
+    v.iter().map(|&p| areas[p as usize]).sum()
+}
+
+fn iou(areas: &[f64], a: &[u32], b: &[u32]) -> f64 {
+    let mut inter = Vec::new();
+    intersect_sorted(a, b, &mut inter);
+    let i = area(areas, &inter);
+    let u = area(areas, a) + area(areas, b) - i;
+    if u > 0.0 { i / u } else { 1.0 }
+}
+
+fn tuple_hash(tuple: &[Vec<u32>]) -> [u8; 32] {
+    let mut h = blake3::Hasher::new();
+    for r in tuple {
+        h.update(&(r.len() as u64).to_le_bytes());
+        for v in r {
+            h.update(&v.to_le_bytes());
+        }
+    }
+    *h.finalize().as_bytes()
+}
+
+/// The triangles `(i < j < k)` of the graph, a deterministic evenly spaced sample of `count`.
+fn sample_triangles(graph: &ShapeGraph, count: usize) -> Vec<[usize; 3]> {
+    if count == 0 {
+        return Vec::new();
+    }
+    let n = graph.node_count();
+    let mut all = Vec::new();
+    for i in 0..n {
+        let ni: Vec<usize> = graph
+            .neighbours(i)
+            .iter()
+            .map(|x| x.0)
+            .filter(|&j| j > i)
+            .collect();
+        for (a, &j) in ni.iter().enumerate() {
+            for &k in &ni[a + 1..] {
+                if graph.edge(j, k).is_some() {
+                    all.push([i, j, k]);
+                }
+            }
+        }
+    }
+    if all.len() <= count {
+        return all;
+    }
+    (0..count).map(|t| all[t * all.len() / count]).collect()
+}
+
+/// One simultaneous (Jacobi) application of the update to `tuple`:
+/// `out_i = P_α(Σ_j w_ij W_ij f_j / (N_ij |f_j|))` on `remaining[i]` for every shape, with
+/// `α = options.alpha()`. A converged tuple of [`cosegment`] (given the remaining sets it was
+/// found on, [`Cosegmentation::remaining_before`]) is returned unchanged.
+pub fn cosegment_update(
+    graph: &ShapeGraph,
+    remaining: &[Vec<u32>],
+    tuple: &[Vec<u32>],
+    options: &CosegmentOptions,
+) -> Result<Vec<Vec<u32>>, GraphError> {
+    check(graph, options)?;
+    let n = graph.node_count();
+    if remaining.len() != n || tuple.len() != n {
+        return Err(GraphError::BadOption(format!(
+            "{n} shapes but {} remaining sets and {} regions",
+            remaining.len(),
+            tuple.len()
+        )));
+    }
+    let mut eng = Engine::new(graph);
+    for (i, r) in tuple.iter().enumerate() {
+        eng.set_region(i, r);
+    }
+    let mut scores = Vec::new();
+    let mut out = Vec::with_capacity(n);
+    for (i, rem) in remaining.iter().enumerate() {
+        eng.scores(i, None, rem, &mut scores);
+        let mut f = Vec::new();
+        eng.select(i, rem, &scores, options.alpha(), &mut f);
+        out.push(f);
+    }
+    Ok(out)
+}
+
+/// Co-segments every shape of `graph` into `options.regions` corresponding regions (see the
+/// module docs for the algorithm). Deterministic: same graph and options, identical output.
+///
+/// ```
+/// use coseg::bands::equal_count_bands;
+/// use coseg::graph::{cosegment, CosegmentOptions, GraphOptions, ShapeGraph, ShapeNode};
+/// let vals: Vec<f64> = (0..12).map(|v| v as f64).collect();
+/// let t = equal_count_bands(&vals, 1, 12, 3).unwrap();
+/// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 12]).unwrap()).collect();
+/// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
+/// let c = cosegment(&g, &CosegmentOptions { regions: 3, ..Default::default() }).unwrap();
+/// // Identical shapes: identical labels.
+/// assert_eq!(c.labels(0), c.labels(1));
+/// assert_eq!(c.labels(0), c.labels(2));
+/// ```
+pub fn cosegment(
+    graph: &ShapeGraph,
+    options: &CosegmentOptions,
+) -> Result<Cosegmentation, GraphError> {
+    check(graph, options)?;
+    let n = graph.node_count();
+    let alpha = options.alpha();
+    let (root, order, parent) = spanning_tree(graph, options.root);
+    let mut eng = Engine::new(graph);
+    let mut rem: Vec<Vec<u32>> = (0..n)
+        .map(|i| (0..graph.node(i).bands.vertices as u32).collect())
+        .collect();
+    // Operators of the sampled triangles, built once.
+    let triangles = sample_triangles(graph, options.triangles);
+    let mut tri_ops = Vec::with_capacity(triangles.len());
+    for t in &triangles {
+        let mut ops = Vec::with_capacity(3);
+        for s in 0..3 {
+            let (a, b) = (t[s], t[(s + 1) % 3]);
+            let op = graph
+                .affinity(a, b)
+                .ok_or_else(|| GraphError::BadOption("triangle edge missing".into()))??;
+            ops.push(op);
+        }
+        tri_ops.push(ops);
+    }
+    let mut tuples = Vec::with_capacity(options.regions);
+    let mut scores = Vec::new();
+    let mut f = Vec::new();
+    for r in 0..options.regions.saturating_sub(1) {
+        if rem.iter().any(Vec::is_empty) {
+            break;
+        }
+        let mut tuple: Vec<Vec<u32>> = vec![Vec::new(); n];
+        for i in 0..n {
+            eng.set_region(i, &[]);
+        }
+        tuple[root] = seed_region(graph, root, &rem[root], options.seed, r);
+        eng.set_region(root, &tuple[root]);
+        for &c in &order[1..] {
+            let p = parent[c].expect("non-root has a parent");
+            eng.scores(c, Some(&[p]), &rem[c], &mut scores);
+            eng.select(c, &rem[c], &scores, alpha, &mut f);
+            tuple[c].clone_from(&f);
+            eng.set_region(c, &f);
+        }
+        let mut seen = vec![tuple_hash(&tuple)];
+        let mut best: Option<(f64, Vec<Vec<u32>>)> = None;
+        let (mut sweeps, mut converged, mut cycled, mut objective) = (0, false, false, 0.0);
+        while sweeps < options.max_sweeps {
+            sweeps += 1;
+            let mut changed = false;
+            objective = 0.0;
+            for &i in &order {
+                eng.scores(i, None, &rem[i], &mut scores);
+                eng.select(i, &rem[i], &scores, alpha, &mut f);
+                objective += super::stable_cycle::selected_sum(&rem[i], &scores, &f);
+                if f != tuple[i] {
+                    changed = true;
+                    tuple[i].clone_from(&f);
+                    eng.set_region(i, &f);
+                }
+            }
+            if !changed {
+                converged = true;
+                break;
+            }
+            if best.as_ref().is_none_or(|b| objective > b.0) {
+                best = Some((objective, tuple.clone()));
+            }
+            let h = tuple_hash(&tuple);
+            if seen.contains(&h) {
+                cycled = true;
+                break;
+            }
+            seen.push(h);
+        }
+        if !converged && let Some((o, t)) = best {
+            objective = o;
+            tuple = t;
+            for (i, region) in tuple.iter().enumerate() {
+                eng.set_region(i, region);
+            }
+        }
+        let (confidence, cyc) =
+            confidence(graph, &mut eng, &parent, &tri_ops, &triangles, &rem, &tuple);
+        for (i, region) in tuple.iter().enumerate() {
+            remove_sorted(&mut rem[i], region);
+        }
+        tuples.push(RegionTuple {
+            area_fractions: tuple
+                .iter()
+                .enumerate()
+                .map(|(i, t)| area(&graph.node(i).areas, t))
+                .collect(),
+            regions: tuple,
+            sweeps,
+            converged,
+            cycled,
+            objective,
+            confidence,
+            cycle_consistency: cyc,
+            leftover: false,
+        });
+    }
+    // The leftovers.
+    if rem.iter().any(|r| !r.is_empty()) || tuples.is_empty() {
+        let tuple = rem.clone();
+        for (i, region) in tuple.iter().enumerate() {
+            eng.set_region(i, region);
+        }
+        let (confidence, cyc) =
+            confidence(graph, &mut eng, &parent, &tri_ops, &triangles, &rem, &tuple);
+        tuples.push(RegionTuple {
+            area_fractions: tuple
+                .iter()
+                .enumerate()
+                .map(|(i, t)| area(&graph.node(i).areas, t))
+                .collect(),
+            regions: tuple,
+            sweeps: 0,
+            converged: true,
+            cycled: false,
+            objective: 0.0,
+            confidence,
+            cycle_consistency: cyc,
+            leftover: true,
+        });
+    }
+    Ok(Cosegmentation {
+        names: (0..n).map(|i| graph.node(i).name.clone()).collect(),
+        vertices: (0..n).map(|i| graph.node(i).bands.vertices).collect(),
+        root,
+        order,
+        parent,
+        alpha,
+        tuples,
+    })
+}
+
+/// Tree-edge agreement and triangle cycle consistency of a tuple (the engine's histograms hold
+/// the tuple's regions).
+fn confidence(
+    graph: &ShapeGraph,
+    eng: &mut Engine<'_>,
+    parent: &[Option<usize>],
+    tri_ops: &[Vec<(BandAffinity<'_>, crate::affinity::Direction)>],
+    triangles: &[[usize; 3]],
+    rem: &[Vec<u32>],
+    tuple: &[Vec<u32>],
+) -> (f64, Option<f64>) {
+    let mut scores = Vec::new();
+    let mut carried = Vec::new();
+    let (mut sum, mut count) = (0.0, 0usize);
+    for (c, p) in parent.iter().enumerate() {
+        let Some(p) = *p else { continue };
+        for (dst, src) in [(c, p), (p, c)] {
+            let areas = &graph.node(dst).areas;
+            eng.scores(dst, Some(&[src]), &rem[dst], &mut scores);
+            threshold(
+                Threshold::Count(tuple[dst].len()),
+                &rem[dst],
+                &scores,
+                areas,
+                1.0,
+                &mut carried,
+                &mut eng.scratch,
+            );
+            sum += iou(areas, &tuple[dst], &carried);
+            count += 1;
+        }
+    }
+    let conf = if count > 0 { sum / count as f64 } else { 1.0 };
+    if triangles.is_empty() {
+        return (conf, None);
+    }
+    let mut total = 0.0;
+    for (t, ops) in triangles.iter().zip(tri_ops) {
+        let shapes: Vec<CycleShape<'_>> = t
+            .iter()
+            .map(|&i| {
+                let areas = &graph.node(i).areas;
+                CycleShape {
+                    remaining: &rem[i],
+                    areas,
+                    reference_area: 1.0,
+                    rule: Threshold::Count(tuple[i].len()),
+                }
+            })
+            .collect();
+        let steps: Vec<CycleStep<'_, '_>> = ops
+            .iter()
+            .map(|(w, d)| CycleStep {
+                affinity: w,
+                direction: *d,
+            })
+            .collect();
+        total += cycle_consistency(&shapes, &steps, &tuple[t[0]])
+            .map(|c| c.iou)
+            .unwrap_or(0.0);
+    }
+    (conf, Some(total / triangles.len() as f64))
+}

@@ -1,0 +1,467 @@
+//! Tests of the shape graph, the cycle solver and the collection co-segmentation.
+
+mod common;
+
+use common::graph::{curve_table, permutation, permute_table, permute_values, random_weights};
+use common::stable::{noisy_copy, random_table, random_vec};
+use coseg::affinity::{BandAffinity, Direction, FeaturePairing};
+use coseg::bands::BandTable;
+use coseg::graph::{
+    CosegmentOptions, CycleShape, CycleStep, GraphKind, GraphOptions, ShapeGraph, ShapeNode,
+    StableCycleOptions, cosegment, cosegment_update, cycle_consistency, stable_cycle,
+};
+use coseg::stable::{Remaining, StablePairOptions, Threshold, stable_pair};
+
+fn all(n: usize) -> Vec<u32> {
+    (0..n as u32).collect()
+}
+
+/// Every `step`-th vertex dropped: a remaining subset.
+fn subset(n: usize, drop_every: usize) -> Vec<u32> {
+    (0..n as u32)
+        .filter(|v| drop_every == 0 || v % drop_every as u32 != 0)
+        .collect()
+}
+
+#[test]
+fn two_cycle_is_exactly_algorithm_one() {
+    let rules = [
+        (Threshold::Count(13), Threshold::Count(9)),
+        (Threshold::AreaFraction(0.15), Threshold::AreaFraction(0.2)),
+        (Threshold::MeanStd(0.5), Threshold::MeanStd(0.8)),
+        (Threshold::Count(40), Threshold::AreaFraction(0.3)),
+    ];
+    let mut compared = 0;
+    for seed in 0..6u64 {
+        let (da, db) = (90 + seed as usize * 7, 110 - seed as usize * 5);
+        let a = random_table(da, 24, 6, seed);
+        let b = if seed % 2 == 0 {
+            random_table(db, 24, 6, 100 + seed)
+        } else {
+            // Correlated shapes (same size) give non-trivial stable pairs.
+            noisy_copy(&a, 0.6, 200 + seed)
+        };
+        let db = b.vertices;
+        let weighted = seed % 3 == 2;
+        let pairing = if weighted {
+            FeaturePairing::new(
+                (0..24).map(|k| (k, (k * 5) % 24)).collect(),
+                Some(random_weights(24, seed)),
+            )
+        } else {
+            FeaturePairing::identity(24)
+        };
+        let w = BandAffinity::with_pairing(&a, &b, &pairing).unwrap();
+        let areas_a = random_vec(da, 10 + seed);
+        let areas_b = random_vec(db, 20 + seed);
+        let (ra, rb) = (subset(da, (seed % 4) as usize), subset(db, 3));
+        let ref_a: f64 = ra.iter().map(|&v| areas_a[v as usize]).sum();
+        let ref_b: f64 = areas_b.iter().sum();
+        for (p, q) in rules {
+            for f0 in [vec![0u32, 5, 17], (0..da as u32).step_by(2).collect()] {
+                for max_iterations in [1, 3, 100] {
+                    let rem = Remaining {
+                        vertices_a: &ra,
+                        vertices_b: &rb,
+                        areas_a: &areas_a,
+                        areas_b: &areas_b,
+                        reference_area_a: ref_a,
+                        reference_area_b: ref_b,
+                    };
+                    let opts = StablePairOptions {
+                        p,
+                        q,
+                        max_iterations,
+                    };
+                    let pair = stable_pair(&w, &rem, &f0, &opts).unwrap();
+                    let shapes = [
+                        CycleShape {
+                            remaining: &ra,
+                            areas: &areas_a,
+                            reference_area: ref_a,
+                            rule: q,
+                        },
+                        CycleShape {
+                            remaining: &rb,
+                            areas: &areas_b,
+                            reference_area: ref_b,
+                            rule: p,
+                        },
+                    ];
+                    let steps = [
+                        CycleStep {
+                            affinity: &w,
+                            direction: Direction::AtoB,
+                        },
+                        CycleStep {
+                            affinity: &w,
+                            direction: Direction::BtoA,
+                        },
+                    ];
+                    let cyc =
+                        stable_cycle(&shapes, &steps, &f0, &StableCycleOptions { max_iterations })
+                            .unwrap();
+                    assert_eq!(cyc.regions[0], pair.region_a, "seed {seed} {p:?} {q:?}");
+                    assert_eq!(cyc.regions[1], pair.region_b, "seed {seed} {p:?} {q:?}");
+                    assert_eq!(cyc.objective.to_bits(), pair.objective.to_bits());
+                    assert_eq!(cyc.iterations, pair.iterations);
+                    assert_eq!(cyc.converged, pair.converged);
+                    assert_eq!(cyc.cycled, pair.cycled);
+                    assert_eq!(cyc.history, pair.history);
+                    compared += 1;
+                }
+            }
+        }
+    }
+    assert_eq!(compared, 6 * 4 * 2 * 3);
+}
+
+#[test]
+fn stable_cycle_rejects_bad_input() {
+    let a = random_table(10, 4, 2, 1);
+    let w = BandAffinity::new(&a, &a).unwrap();
+    let r = all(10);
+    let areas = vec![1.0; 10];
+    let s = CycleShape {
+        remaining: &r,
+        areas: &areas,
+        reference_area: 10.0,
+        rule: Threshold::Count(3),
+    };
+    let step = CycleStep {
+        affinity: &w,
+        direction: Direction::AtoB,
+    };
+    let o = StableCycleOptions::default();
+    assert!(stable_cycle(&[s], &[step], &[0], &o).is_err());
+    assert!(stable_cycle(&[s, s], &[step], &[0], &o).is_err());
+    assert!(stable_cycle(&[s, s], &[step, step], &[3, 1], &o).is_err());
+    let bad = [5u32, 2];
+    let s_bad = CycleShape {
+        remaining: &bad,
+        ..s
+    };
+    assert!(stable_cycle(&[s, s_bad], &[step, step], &[0], &o).is_err());
+    let short = vec![1.0; 9];
+    let s_short = CycleShape {
+        areas: &short,
+        remaining: &r[..9],
+        ..s
+    };
+    assert!(stable_cycle(&[s, s_short], &[step, step], &[0], &o).is_err());
+}
+
+/// Three copies of one shape with permuted vertex orders: the 3-cycle's regions, mapped back
+/// through the permutations, coincide.
+#[test]
+fn three_cycle_of_permuted_copies_agrees() {
+    let d = 240;
+    let base = curve_table(d, 40, 8, 0.3, 7);
+    let p1 = permutation(d, 11);
+    let p2 = permutation(d, 12);
+    let t = [
+        base.clone(),
+        permute_table(&base, &p1),
+        permute_table(&base, &p2),
+    ];
+    // Random feature weights make exact score ties (and index tie-breaks) practically
+    // impossible, so the result cannot depend on the vertex order.
+    let pairing = FeaturePairing::new(
+        (0..40).map(|k| (k, k)).collect(),
+        Some(random_weights(40, 3)),
+    );
+    let w01 = BandAffinity::with_pairing(&t[0], &t[1], &pairing).unwrap();
+    let w12 = BandAffinity::with_pairing(&t[1], &t[2], &pairing).unwrap();
+    let w20 = BandAffinity::with_pairing(&t[2], &t[0], &pairing).unwrap();
+    let areas0 = random_vec(d, 5).iter().map(|x| 0.5 + x).collect::<Vec<_>>();
+    let areas = [
+        areas0.clone(),
+        permute_values(&areas0, &p1),
+        permute_values(&areas0, &p2),
+    ];
+    let r = all(d);
+    let total: f64 = areas0.iter().sum();
+    for rule in [Threshold::Count(30), Threshold::AreaFraction(0.2)] {
+        let shapes: Vec<CycleShape<'_>> = (0..3)
+            .map(|i| CycleShape {
+                remaining: &r,
+                areas: &areas[i],
+                reference_area: total,
+                rule,
+            })
+            .collect();
+        let steps = [&w01, &w12, &w20].map(|w| CycleStep {
+            affinity: w,
+            direction: Direction::AtoB,
+        });
+        for f0 in [vec![3u32], vec![100, 101, 102, 150]] {
+            let c = stable_cycle(&shapes, &steps, &f0, &StableCycleOptions::default()).unwrap();
+            assert!(c.converged, "{rule:?}: {c:?}");
+            assert!(!c.regions[0].is_empty());
+            let back = |region: &[u32], perm: &[u32]| {
+                let mut inv = vec![0u32; d];
+                for (v, &p) in perm.iter().enumerate() {
+                    inv[p as usize] = v as u32;
+                }
+                let mut m: Vec<u32> = region.iter().map(|&q| inv[q as usize]).collect();
+                m.sort_unstable();
+                m
+            };
+            assert_eq!(back(&c.regions[1], &p1), c.regions[0], "{rule:?}");
+            assert_eq!(back(&c.regions[2], &p2), c.regions[0], "{rule:?}");
+            // The fixed point comes back to itself around the cycle.
+            let cc = cycle_consistency(&shapes, &steps, &c.regions[0]).unwrap();
+            assert_eq!(cc.iou, 1.0);
+            assert_eq!(cc.carried[0], c.regions[0]);
+            // A region that is not a fixed point does not (random vertices spread out).
+            let scattered: Vec<u32> = (0..d as u32).step_by(8).collect();
+            let cs = cycle_consistency(&shapes, &steps, &scattered).unwrap();
+            assert!(cs.iou < 1.0);
+        }
+    }
+}
+
+fn nodes_from(tables: &[BandTable], areas: &[Vec<f64>]) -> Vec<ShapeNode> {
+    tables
+        .iter()
+        .zip(areas)
+        .enumerate()
+        .map(|(i, (t, a))| ShapeNode::new(format!("s{i}"), t.clone(), a).unwrap())
+        .collect()
+}
+
+/// A noisy collection: copies of one curve shape with labels perturbed.
+fn noisy_collection(n: usize, d: usize, seed: u64) -> (Vec<BandTable>, Vec<Vec<f64>>) {
+    let base = curve_table(d, 32, 8, 0.2, seed);
+    let tables: Vec<BandTable> = (0..n)
+        .map(|i| noisy_copy(&base, 0.8, seed * 100 + i as u64))
+        .collect();
+    let areas = (0..n)
+        .map(|i| {
+            random_vec(d, seed * 1000 + i as u64)
+                .iter()
+                .map(|x| 0.5 + x)
+                .collect()
+        })
+        .collect();
+    (tables, areas)
+}
+
+#[test]
+fn cosegment_tuples_are_fixed_points_and_partition() {
+    let (tables, areas) = noisy_collection(5, 200, 3);
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    let opts = CosegmentOptions {
+        regions: 5,
+        ..Default::default()
+    };
+    let c = cosegment(&g, &opts).unwrap();
+    assert_eq!(c.tuples.len(), 5);
+    assert!(c.tuples.last().unwrap().leftover);
+    let mut converged = 0;
+    for (r, t) in c.tuples.iter().enumerate() {
+        assert!((0.0..=1.0).contains(&t.confidence));
+        if t.leftover || !t.converged {
+            continue;
+        }
+        converged += 1;
+        let rem: Vec<Vec<u32>> = (0..5).map(|i| c.remaining_before(r, i)).collect();
+        let again = cosegment_update(&g, &rem, &t.regions, &opts).unwrap();
+        assert_eq!(again, t.regions, "tuple {r} is not a fixed point");
+        // Perturbing the tuple breaks the fixed point (the check can fail).
+        let mut moved = t.regions.clone();
+        moved[0] = rem[0]
+            .iter()
+            .copied()
+            .filter(|v| !t.regions[0].contains(v))
+            .take(t.regions[0].len())
+            .collect();
+        assert_ne!(cosegment_update(&g, &rem, &moved, &opts).unwrap(), moved);
+    }
+    assert!(converged >= 3, "only {converged} converged tuples");
+    // Every vertex gets exactly one region; regions have about α of the area.
+    for i in 0..5 {
+        let labels = c.labels(i);
+        assert!(labels.iter().all(|&l| (0..5).contains(&l)));
+        for t in &c.tuples[..4] {
+            assert!(t.area_fractions[i] >= c.alpha - 1e-12);
+            assert!(t.area_fractions[i] < c.alpha + 0.02);
+        }
+    }
+}
+
+#[test]
+fn cosegment_of_permuted_copies_gives_the_same_regions() {
+    let d = 240;
+    let base = curve_table(d, 40, 8, 0.3, 21);
+    let perms: Vec<Vec<u32>> = (0..4)
+        .map(|i| {
+            if i == 0 {
+                all(d)
+            } else {
+                permutation(d, 50 + i)
+            }
+        })
+        .collect();
+    let areas0: Vec<f64> = random_vec(d, 9).iter().map(|x| 0.5 + x).collect();
+    let tables: Vec<BandTable> = perms.iter().map(|p| permute_table(&base, p)).collect();
+    let areas: Vec<Vec<f64>> = perms.iter().map(|p| permute_values(&areas0, p)).collect();
+    let mut g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    g.set_feature_weights(Some(random_weights(40, 8))).unwrap();
+    let c = cosegment(
+        &g,
+        &CosegmentOptions {
+            regions: 4,
+            root: Some(0),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let l0 = c.labels(0);
+    for (i, p) in perms.iter().enumerate().skip(1) {
+        let li = c.labels(i);
+        let back: Vec<i32> = (0..d).map(|v| li[p[v] as usize]).collect();
+        assert_eq!(back, l0, "shape {i}");
+    }
+    for t in &c.tuples {
+        if !t.leftover {
+            assert!(t.converged);
+            assert_eq!(t.confidence, 1.0);
+            assert_eq!(t.cycle_consistency, Some(1.0));
+        }
+    }
+}
+
+#[test]
+fn cosegment_is_deterministic() {
+    let (tables, areas) = noisy_collection(6, 150, 5);
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    for seed in [None, Some(42)] {
+        let o = CosegmentOptions {
+            regions: 4,
+            seed,
+            ..Default::default()
+        };
+        let a = cosegment(&g, &o).unwrap();
+        let b = cosegment(&g, &o).unwrap();
+        assert_eq!(a, b);
+        let sa = serde_json::to_string(&a).unwrap();
+        assert_eq!(sa, serde_json::to_string(&b).unwrap());
+    }
+}
+
+#[test]
+fn cosegment_rejects_bad_options() {
+    let (tables, areas) = noisy_collection(3, 60, 1);
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    for o in [
+        CosegmentOptions {
+            regions: 0,
+            ..Default::default()
+        },
+        CosegmentOptions {
+            area_fraction: Some(1.5),
+            ..Default::default()
+        },
+        CosegmentOptions {
+            root: Some(3),
+            ..Default::default()
+        },
+        CosegmentOptions {
+            max_sweeps: 0,
+            ..Default::default()
+        },
+    ] {
+        assert!(cosegment(&g, &o).is_err(), "{o:?}");
+    }
+    let one = ShapeGraph::build(
+        nodes_from(&tables[..1], &areas[..1]),
+        &GraphOptions::default(),
+    )
+    .unwrap();
+    assert!(cosegment(&one, &CosegmentOptions::default()).is_err());
+}
+
+#[test]
+fn small_collections_get_a_complete_graph() {
+    let (tables, areas) = noisy_collection(7, 40, 2);
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    assert_eq!(g.kind(), GraphKind::Complete);
+    assert_eq!(g.edge_count(), 21);
+    for i in 0..7 {
+        assert_eq!(g.neighbours(i).len(), 6);
+    }
+    for (_, _, e) in g.edges() {
+        assert!(e.weight > 0.0 && e.weight <= 1.0);
+    }
+}
+
+#[test]
+fn large_collections_get_a_connected_nearest_neighbour_graph() {
+    // Two clusters of similar shapes: with k = 2 the nearest neighbours stay within each
+    // cluster, so only the spanning tree can connect them.
+    let (a, aa) = noisy_collection(8, 60, 30);
+    let b: Vec<BandTable> = (0..8)
+        .map(|i| noisy_copy(&random_table(60, 32, 8, 77), 0.9, 300 + i))
+        .collect();
+    let tables: Vec<BandTable> = a.into_iter().chain(b).collect();
+    let areas: Vec<Vec<f64>> = aa.iter().cloned().chain(aa.iter().cloned()).collect();
+    let opts = GraphOptions {
+        complete_limit: 10,
+        neighbours: 2,
+        ..Default::default()
+    };
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &opts).unwrap();
+    assert_eq!(g.kind(), GraphKind::Nearest(2));
+    assert!(g.is_connected());
+    assert!(g.edge_count() < 16 * 15 / 2);
+    let cross: Vec<_> = g
+        .edges()
+        .into_iter()
+        .filter(|(i, j, _)| (*i < 8) != (*j < 8))
+        .collect();
+    assert_eq!(
+        cross.len(),
+        1,
+        "exactly the spanning tree's bridge crosses clusters"
+    );
+    for i in 0..16 {
+        assert!(g.neighbours(i).len() >= 2);
+    }
+    // And the co-segmentation runs on it.
+    let c = cosegment(
+        &g,
+        &CosegmentOptions {
+            regions: 3,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    assert_eq!(c.order.len(), 16);
+    // Deterministic construction.
+    let g2 = ShapeGraph::build(nodes_from(&tables, &areas), &opts).unwrap();
+    let e1: Vec<(usize, usize, u64)> = g
+        .edges()
+        .iter()
+        .map(|(i, j, e)| (*i, *j, e.weight.to_bits()))
+        .collect();
+    let e2: Vec<(usize, usize, u64)> = g2
+        .edges()
+        .iter()
+        .map(|(i, j, e)| (*i, *j, e.weight.to_bits()))
+        .collect();
+    assert_eq!(e1, e2);
+}
+
+#[test]
+fn graph_rejects_incompatible_shapes() {
+    let a = random_table(20, 8, 4, 1);
+    let b = random_table(20, 8, 5, 2);
+    let nodes = vec![
+        ShapeNode::new("a", a, &[1.0; 20]).unwrap(),
+        ShapeNode::new("b", b, &[1.0; 20]).unwrap(),
+    ];
+    assert!(ShapeGraph::build(nodes, &GraphOptions::default()).is_err());
+    assert!(ShapeNode::new("c", random_table(20, 8, 4, 3), &[1.0; 19]).is_err());
+    assert!(ShapeNode::new("d", random_table(20, 8, 4, 3), &[0.0; 20]).is_err());
+}
