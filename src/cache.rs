@@ -32,7 +32,7 @@ use thiserror::Error;
 
 /// Version of the cache file format and of the computations it stores. Bump it whenever the
 /// layout or any algorithm's output changes: older files then read as stale and are recomputed.
-pub const FORMAT_VERSION: u32 = 1;
+pub const FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"COSEGSHP";
 const HEADER_LEN: usize = 8 + 4 + 32 + 8 + 32;

@@ -4,9 +4,9 @@ mod convert;
 mod features;
 mod generate;
 mod info;
-mod spectrum;
 mod pair;
 mod segment;
+mod spectrum;
 
 use clap::{Parser, Subcommand};
 use std::process::ExitCode;

@@ -183,7 +183,7 @@ struct Engine<'g> {
     /// Size of the current region of each shape.
     size: Vec<usize>,
     table: Vec<f64>,
-    scratch: Vec<u32>,
+    scratch: crate::stable::ThresholdScratch,
 }
 
 struct Neighbour {
@@ -242,7 +242,7 @@ impl<'g> Engine<'g> {
             hist,
             size: vec![0; n],
             table: Vec::new(),
-            scratch: Vec::new(),
+            scratch: Default::default(),
         }
     }
 

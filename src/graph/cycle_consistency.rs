@@ -64,7 +64,7 @@ pub fn cycle_consistency(
     intersect_sorted(region, shapes[0].remaining, &mut start);
     let mut carried: Vec<Vec<u32>> = vec![Vec::new(); m];
     let mut current = start.clone();
-    let mut scratch = Vec::new();
+    let mut scratch = crate::stable::ThresholdScratch::default();
     for (i, step) in steps.iter().enumerate() {
         let j = (i + 1) % m;
         let dst = &shapes[j];

@@ -204,7 +204,7 @@ pub fn stable_cycle_with(
         .iter()
         .map(|s| vec![0.0; s.remaining.len()])
         .collect();
-    let mut scratch = Vec::new();
+    let mut scratch = crate::stable::ThresholdScratch::default();
     // regions[i]: current f_i; regions[0] is the f_0 the round starts from.
     let mut regions: Vec<Vec<u32>> = vec![Vec::new(); m];
     intersect_sorted(f0, shapes[0].remaining, &mut regions[0]);

@@ -12,7 +12,6 @@ mod lumped_mass;
 mod shift_invert;
 
 pub use cotan_laplacian::cotan_laplacian;
-pub use laplace_beltrami_spectrum::{SpectrumOptions, dense_spectrum, laplace_beltrami_spectrum};
 pub use laplace_beltrami_spectrum::{
     SpectrumOptions, SpectrumStats, dense_spectrum, laplace_beltrami_spectrum,
     laplace_beltrami_spectrum_with_stats,

@@ -5,5 +5,5 @@ pub mod features;
 pub mod generate;
 pub mod graph;
 pub mod mesh;
-pub mod stable;
 pub mod shapes;
+pub mod stable;
