@@ -3,75 +3,11 @@
 #![allow(dead_code)]
 
 use coseg::mesh::TriMesh;
-use std::collections::HashMap;
 
 /// Unit icosphere: an icosahedron subdivided `level` times, vertices projected on the unit
 /// sphere (10·4^level + 2 vertices), counter-clockwise seen from outside.
 pub fn icosphere(level: usize) -> TriMesh {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut pos: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut faces: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let unit = |p: [f64; 3]| {
-        let n = (p[0] * p[0] + p[1] * p[1] + p[2] * p[2]).sqrt();
-        [p[0] / n, p[1] / n, p[2] / n]
-    };
-    for p in pos.iter_mut() {
-        *p = unit(*p);
-    }
-    for _ in 0..level {
-        let mut mid: HashMap<(u32, u32), u32> = HashMap::new();
-        let mut next = Vec::with_capacity(faces.len() * 4);
-        let mut midpoint = |a: u32, b: u32, pos: &mut Vec<[f64; 3]>| -> u32 {
-            let k = (a.min(b), a.max(b));
-            *mid.entry(k).or_insert_with(|| {
-                let (p, q) = (pos[a as usize], pos[b as usize]);
-                pos.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
-                (pos.len() - 1) as u32
-            })
-        };
-        for &[a, b, c] in &faces {
-            let ab = midpoint(a, b, &mut pos);
-            let bc = midpoint(b, c, &mut pos);
-            let ca = midpoint(c, a, &mut pos);
-            next.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        faces = next;
-    }
-    TriMesh::new(pos, faces).unwrap()
+    super::shapes::icosphere(level as u32, 1.0)
 }
 
 /// A smooth, star-shaped, asymmetric blob (no symmetry, so generic simple eigenvalues and no
