@@ -25,17 +25,7 @@ pub fn area_weighted_bands(
     vertices: usize,
     bands: usize,
 ) -> Result<BandTable, BandError> {
-    if bands == 0 || bands > 256 {
-        return Err(BandError::BadBandCount(bands));
-    }
-    if values.len() != features * vertices {
-        return Err(BandError::ShapeMismatch {
-            features,
-            vertices,
-            expected: features * vertices,
-            got: values.len(),
-        });
-    }
+    super::check_table_input(values, features, vertices, bands)?;
     if weights.len() != vertices {
         return Err(BandError::BadWeights(format!(
             "{} weights for {vertices} vertices",

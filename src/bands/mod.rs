@@ -97,17 +97,7 @@ pub fn equal_count_bands(
     vertices: usize,
     bands: usize,
 ) -> Result<BandTable, BandError> {
-    if bands == 0 || bands > 256 {
-        return Err(BandError::BadBandCount(bands));
-    }
-    if values.len() != features * vertices {
-        return Err(BandError::ShapeMismatch {
-            features,
-            vertices,
-            expected: features * vertices,
-            got: values.len(),
-        });
-    }
+    check_table_input(values, features, vertices, bands)?;
     ranked_labels(values, features, vertices, bands, None)
 }
 
@@ -289,4 +279,26 @@ fn bucket_count_bands(f: &[f64], bands: usize, scratch: &mut Vec<u128>, col: &mu
         }
         i = j;
     }
+}
+
+/// Checks what every band builder needs: `K` fits a `u8` label and `values` holds
+/// `features × vertices` entries.
+pub(crate) fn check_table_input(
+    values: &[f64],
+    features: usize,
+    vertices: usize,
+    bands: usize,
+) -> Result<(), BandError> {
+    if bands == 0 || bands > 256 {
+        return Err(BandError::BadBandCount(bands));
+    }
+    if values.len() != features * vertices {
+        return Err(BandError::ShapeMismatch {
+            features,
+            vertices,
+            expected: features * vertices,
+            got: values.len(),
+        });
+    }
+    Ok(())
 }

@@ -1,7 +1,6 @@
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::bands::BandWeighting;
-use coseg::cache::{CacheOutcome, ShapePipelineOptions, compute_shape_data, load_or_compute};
+use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
 use coseg::features::{ExportFormat, ExportOptions, export_features};
 use coseg::mesh::read_mesh_with_report;
 use std::path::PathBuf;
@@ -26,24 +25,8 @@ pub struct FeaturesArgs {
     /// Also write the unit-area spectrum (eigenvalues, eigenvectors, vertex areas).
     #[arg(long)]
     spectrum: bool,
-    /// Number of Laplace–Beltrami eigenpairs.
-    #[arg(long, default_value_t = 200)]
-    eigenpairs: usize,
-    /// Number of HKS features.
-    #[arg(long, default_value_t = 100)]
-    hks: usize,
-    /// Number of WKS features.
-    #[arg(long, default_value_t = 100)]
-    wks: usize,
-    /// Number of multiscale mean-curvature features.
-    #[arg(long, default_value_t = 100)]
-    curvature: usize,
-    /// Number of bands K.
-    #[arg(long, default_value_t = 20)]
-    bands: usize,
-    /// Cut bands by equal area instead of equal vertex count.
-    #[arg(long)]
-    area_bands: bool,
+    #[command(flatten)]
+    pipeline: super::pipeline_args::PipelineArgs,
     /// Per-shape cache directory (read if valid, written otherwise).
     #[arg(long)]
     cache: Option<PathBuf>,
@@ -54,15 +37,7 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
     for w in &report.warnings {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
-    let mut opts = ShapePipelineOptions::default();
-    opts.spectrum.eigenpairs = args.eigenpairs;
-    opts.descriptors.hks_count = args.hks;
-    opts.descriptors.wks_count = args.wks;
-    opts.descriptors.curvature_count = args.curvature;
-    opts.bands.bands = args.bands;
-    if args.area_bands {
-        opts.bands.weighting = BandWeighting::Area;
-    }
+    let opts = args.pipeline.options();
     let data = match &args.cache {
         Some(dir) => {
             let r = load_or_compute(&mesh, &opts, dir)

@@ -5,6 +5,7 @@ mod features;
 mod generate;
 mod info;
 mod pair;
+mod pipeline_args;
 mod segment;
 mod spectrum;
 

@@ -2,8 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::bands::BandWeighting;
-use coseg::cache::{CacheOutcome, ShapePipelineOptions, compute_shape_data, load_or_compute};
+use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
 use coseg::mesh::read_mesh_with_report;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
 use coseg::stable::{
@@ -76,24 +75,8 @@ pub struct PairArgs {
     /// vertex of A (negative = none).
     #[arg(long)]
     ground_truth: Option<String>,
-    /// Number of Laplace–Beltrami eigenpairs.
-    #[arg(long, default_value_t = 200)]
-    eigenpairs: usize,
-    /// Number of HKS features.
-    #[arg(long, default_value_t = 100)]
-    hks: usize,
-    /// Number of WKS features.
-    #[arg(long, default_value_t = 100)]
-    wks: usize,
-    /// Number of multiscale mean-curvature features.
-    #[arg(long, default_value_t = 100)]
-    curvature: usize,
-    /// Number of bands K.
-    #[arg(long, default_value_t = 20)]
-    bands: usize,
-    /// Cut bands by equal area instead of equal vertex count.
-    #[arg(long)]
-    area_bands: bool,
+    #[command(flatten)]
+    pipeline: super::pipeline_args::PipelineArgs,
 }
 
 fn stem(p: &Path) -> String {
@@ -102,15 +85,7 @@ fn stem(p: &Path) -> String {
 }
 
 pub fn run(args: PairArgs) -> Result<ExitCode> {
-    let mut pipe = ShapePipelineOptions::default();
-    pipe.spectrum.eigenpairs = args.eigenpairs;
-    pipe.descriptors.hks_count = args.hks;
-    pipe.descriptors.wks_count = args.wks;
-    pipe.descriptors.curvature_count = args.curvature;
-    pipe.bands.bands = args.bands;
-    if args.area_bands {
-        pipe.bands.weighting = BandWeighting::Area;
-    }
+    let pipe = args.pipeline.options();
     let mut loaded = Vec::new();
     for path in [&args.a, &args.b] {
         let (mesh, report) = read_mesh_with_report(path)?;
