@@ -10,17 +10,20 @@
 //! each configuration (Algorithm 2 at a 10 % area cutoff, Algorithm 3), plus the time spent in
 //! the stable-region algorithm (per-shape data are cached and excluded).
 
+use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
 use coseg::cache::{ShapePipelineOptions, load_or_compute};
 use coseg::mesh::read_mesh;
+use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, StableRegionsOptions, TSearch, VertexMap, correspondence_stats,
-    stable_regions,
+    Algorithm, AreaReference, Init, RefineOptions, StableRegionsOptions, TSearch, VertexMap,
+    correspondence_stats, refine_regions, stable_regions,
 };
 use std::path::PathBuf;
 use std::time::Instant;
 
-fn configs() -> Vec<(&'static str, StableRegionsOptions)> {
+/// `(name, options, refine)`: `refine` runs [`refine_regions`] (default options) on the result.
+fn configs() -> Vec<(&'static str, StableRegionsOptions, bool)> {
     // Explicit inits: the configurations do not depend on the library's default.
     let base = StableRegionsOptions {
         init: Init::Extreme,
@@ -31,13 +34,14 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions)> {
         ..base.clone()
     };
     vec![
-        ("alg2-extreme", base.clone()),
+        ("alg2-extreme", base.clone(), false),
         (
             "alg2-random",
             StableRegionsOptions {
                 init: Init::Random,
                 ..base.clone()
             },
+            false,
         ),
         (
             "alg2-extreme-remaining",
@@ -45,14 +49,16 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions)> {
                 area_reference: AreaReference::Remaining,
                 ..base.clone()
             },
+            false,
         ),
-        ("alg3-extreme", auto.clone()),
+        ("alg3-extreme", auto.clone(), false),
         (
             "alg3-random",
             StableRegionsOptions {
                 init: Init::Random,
                 ..auto.clone()
             },
+            false,
         ),
         (
             "alg3-extreme-linear",
@@ -60,6 +66,7 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions)> {
                 t_search: TSearch::Linear,
                 ..auto.clone()
             },
+            false,
         ),
         (
             "alg3-random-linear-cold",
@@ -69,6 +76,23 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions)> {
                 warm_start: false,
                 ..auto.clone()
             },
+            false,
+        ),
+        (
+            "alg2-random-refined",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..base.clone()
+            },
+            true,
+        ),
+        (
+            "alg3-random-refined",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..auto.clone()
+            },
+            true,
         ),
     ]
 }
@@ -134,7 +158,7 @@ fn main() -> anyhow::Result<()> {
     let dir = dir.ok_or_else(|| anyhow::anyhow!("usage: eval_tosca DATA_DIR [options]"))?;
     let configs: Vec<_> = configs()
         .into_iter()
-        .filter(|(n, _)| which == "all" || which.split(',').any(|w| w == *n))
+        .filter(|(n, _, _)| which == "all" || which.split(',').any(|w| w == *n))
         .collect();
     println!("pipeline: {pipe:?}");
     // Per class: the first `shapes` indices present.
@@ -168,14 +192,33 @@ fn main() -> anyhow::Result<()> {
                 t.elapsed().as_secs_f64(),
                 d.outcome
             );
-            data.push((format!("{class}{k}"), mesh.vertex_areas(), d.data.bands));
+            let smoother = HeatSmoother::new(&mesh, RefineOptions::default().smoothing_time)?;
+            data.push((
+                format!("{class}{k}"),
+                mesh.vertex_areas(),
+                d.data.bands,
+                smoother,
+            ));
         }
         for a in 0..data.len() {
             for b in a + 1..data.len() {
                 let mut line = format!("{:>8} x {:<8}", data[a].0, data[b].0);
-                for (k, (_, opts)) in configs.iter().enumerate() {
+                for (k, (_, opts, refine)) in configs.iter().enumerate() {
                     let t = Instant::now();
-                    let r = stable_regions(&data[a].2, &data[b].2, &data[a].1, &data[b].1, opts)?;
+                    let mut r =
+                        stable_regions(&data[a].2, &data[b].2, &data[a].1, &data[b].1, opts)?;
+                    if *refine {
+                        let w = BandAffinity::new(&data[a].2, &data[b].2)?;
+                        r = refine_regions(
+                            &w,
+                            &r,
+                            &data[a].1,
+                            &data[b].1,
+                            Some(&data[a].3),
+                            Some(&data[b].3),
+                            &RefineOptions::default(),
+                        )?;
+                    }
                     times[k] += t.elapsed().as_secs_f64();
                     let st = correspondence_stats(&r, &VertexMap::Identity)?;
                     results[k][ci].push(st.ratio);
@@ -199,7 +242,7 @@ fn main() -> anyhow::Result<()> {
         " {:>7} {:>8} {:>14} {:>9}",
         "mean", "time s", "w/o leftover", "coverage"
     );
-    for (k, (name, _)) in configs.iter().enumerate() {
+    for (k, (name, _, _)) in configs.iter().enumerate() {
         print!("{name:<26}");
         let mut all = Vec::new();
         for r in &results[k] {

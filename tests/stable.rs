@@ -612,3 +612,116 @@ fn correspondence_stats_separate_the_leftover_pair() {
     assert_eq!(s.ratio_without_leftover, 0.5);
     assert_eq!(s.coverage, 2.0 / 6.0);
 }
+
+// ---------------------------------------------------------------------------------------------
+// Partition refinement
+
+/// One round of `refine_partition` without smoothing equals best responses computed from the
+/// dense affinity: B from A's partition, then A from B's new partition.
+#[test]
+fn refine_partition_one_round_matches_dense_best_response() {
+    use coseg::stable::{RefineOptions, refine_partition};
+    let (da, db, n, k, regions) = (70, 55, 12, 5, 4usize);
+    let a = random_table(da, n, k, 41);
+    let b = noisy_copy(&random_table(db, n, k, 42), 0.9, 43);
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let dense = dense_affinity(&w).unwrap();
+    let la: Vec<i32> = (0..da).map(|p| (p * regions / da) as i32).collect();
+    let lb: Vec<i32> = (0..db).map(|q| ((q * 7) % regions) as i32).collect();
+    let best = |scores: &dyn Fn(usize, usize) -> f64, d: usize| -> Vec<i32> {
+        (0..d)
+            .map(|v| {
+                let mut arg = 0;
+                for r in 1..regions {
+                    if scores(v, r) > scores(v, arg) {
+                        arg = r;
+                    }
+                }
+                arg as i32
+            })
+            .collect()
+    };
+    let mean_to = |labels: &[i32], r: usize, f: &dyn Fn(usize) -> f64| -> f64 {
+        let members: Vec<usize> = (0..labels.len())
+            .filter(|&p| labels[p] == r as i32)
+            .collect();
+        members.iter().map(|&p| f(p)).sum::<f64>() / members.len().max(1) as f64 // exact: integer sums
+    };
+    // Integer band-agreement counts, so that equal means are exactly equal (ties → lowest id).
+    let count = |q: usize, p: usize| (dense[q * da + p] / w.unit()).round();
+    let new_b = best(&|q, r| mean_to(&la, r, &|p| count(q, p)), db);
+    let new_a = best(&|p, r| mean_to(&new_b, r, &|q| count(q, p)), da);
+    let opts = RefineOptions {
+        max_rounds: 1,
+        smoothing_time: 0.0,
+    };
+    let r = refine_partition(&w, &la, &lb, None, None, &opts).unwrap();
+    assert_eq!(r.labels_b, new_b);
+    assert_eq!(r.labels_a, new_a);
+    assert_eq!(r.rounds, 1);
+}
+
+/// A converged refinement is a fixed point: refining its output again changes nothing. The
+/// output is deterministic and every vertex gets a region in range.
+#[test]
+fn refine_partition_converged_output_is_a_fixed_point() {
+    use coseg::stable::{RefineOptions, refine_partition};
+    let a = random_table(300, 24, 8, 51);
+    let b = noisy_copy(&a, 0.8, 52);
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let la: Vec<i32> = (0..300).map(|p| (p % 5) as i32).collect();
+    let lb: Vec<i32> = (0..300).map(|q| ((q / 60) % 5) as i32).collect();
+    let opts = RefineOptions {
+        max_rounds: 50,
+        smoothing_time: 0.0,
+    };
+    let r = refine_partition(&w, &la, &lb, None, None, &opts).unwrap();
+    assert!(r.converged, "no fixed point within 50 rounds");
+    assert!(
+        r.labels_a
+            .iter()
+            .chain(&r.labels_b)
+            .all(|&l| (0..5).contains(&l))
+    );
+    assert!(
+        r.margin_a
+            .iter()
+            .chain(&r.margin_b)
+            .all(|m| (0.0..=1.0).contains(m))
+    );
+    let again = refine_partition(&w, &r.labels_a, &r.labels_b, None, None, &opts).unwrap();
+    assert_eq!(again.labels_a, r.labels_a);
+    assert_eq!(again.labels_b, r.labels_b);
+    assert_eq!(again.rounds, 1);
+    assert!(again.converged);
+    let twice = refine_partition(&w, &la, &lb, None, None, &opts).unwrap();
+    assert_eq!(twice, r);
+}
+
+/// A shape against a vertex-permuted copy of itself: a partition of A whose regions are band
+/// blocks of a dominant feature comes back exactly (through the permutation) on B, whatever
+/// B's start.
+#[test]
+fn refine_partition_recovers_a_partition_through_a_permutation() {
+    use coseg::stable::{RefineOptions, refine_partition};
+    let mut a = common::stable::random_equal_table(240, 16, 6, 61);
+    // Features 1..4 repeat feature 0, so the partition by feature 0 dominates the affinity.
+    for p in 0..240 {
+        let l0 = a.labels[p * 16];
+        a.labels[p * 16 + 1..p * 16 + 5].fill(l0);
+    }
+    let (b, perm) = permuted(&a, 62);
+    let w = BandAffinity::new(&a, &b).unwrap();
+    // 3 regions, each the union of two bands of feature 0.
+    let la: Vec<i32> = (0..240).map(|p| (a.labels[p * 16] / 2) as i32).collect();
+    let lb = vec![0; 240];
+    let r = refine_partition(&w, &la, &lb, None, None, &RefineOptions::default()).unwrap();
+    assert!(r.converged);
+    assert_eq!(r.labels_a, la, "A's partition is already optimal");
+    for (p, &q) in perm.iter().enumerate() {
+        assert_eq!(
+            r.labels_b[q as usize], la[p],
+            "vertex {p} of A (= {q} of B)"
+        );
+    }
+}

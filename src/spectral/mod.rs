@@ -7,11 +7,13 @@
 
 mod block_lanczos;
 mod cotan_laplacian;
+mod heat_smoother;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
 mod shift_invert;
 
 pub use cotan_laplacian::cotan_laplacian;
+pub use heat_smoother::HeatSmoother;
 pub use laplace_beltrami_spectrum::{
     SpectrumOptions, SpectrumStats, dense_spectrum, laplace_beltrami_spectrum,
     laplace_beltrami_spectrum_with_stats,

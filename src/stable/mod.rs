@@ -6,10 +6,14 @@
 //! - [`stable_pairs_fixed`]: Algorithm 2 (fixed thresholds).
 //! - [`stable_pairs_auto`]: Algorithm 3 (automatic thresholds).
 //! - [`stable_regions`]: one call from two band tables.
+//! - [`refine_partition`]: smoothed best-response refinement of two corresponding partitions.
+//! - [`refine_regions`]: the same on the output of Algorithms 2 and 3.
 //! - [`correspondence_ratio`]: quality against a ground-truth map (paper §7.2).
 
 mod correspondence_ratio;
 mod initial_indicator;
+mod refine_partition;
+mod refine_regions;
 mod stable_pair;
 mod stable_pairs_auto;
 mod stable_pairs_fixed;
@@ -20,6 +24,10 @@ pub use correspondence_ratio::{
     CorrespondenceStats, VertexMap, correspondence_ratio, correspondence_stats,
 };
 pub use initial_indicator::{Init, initial_indicator};
+pub use refine_partition::{
+    RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
+};
+pub use refine_regions::refine_regions;
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
 };
