@@ -119,7 +119,7 @@ pub fn assign_regions(
     regions: usize,
     smoother: Option<&HeatSmoother>,
 ) -> Result<(Vec<i32>, Vec<f64>), StableError> {
-    if regions == 0 || scores.len() % regions != 0 {
+    if regions == 0 || !scores.len().is_multiple_of(regions) {
         return Err(StableError::BadOption(format!(
             "{} scores do not make {regions} region columns",
             scores.len()
