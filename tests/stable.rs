@@ -669,8 +669,8 @@ fn refine_partition_converged_output_is_a_fixed_point() {
     let a = random_table(300, 24, 8, 51);
     let b = noisy_copy(&a, 0.8, 52);
     let w = BandAffinity::new(&a, &b).unwrap();
-    let la: Vec<i32> = (0..300).map(|p| (p % 5) as i32).collect();
-    let lb: Vec<i32> = (0..300).map(|q| ((q / 60) % 5) as i32).collect();
+    let la: Vec<i32> = (0..300).map(|p| p % 5).collect();
+    let lb: Vec<i32> = (0..300).map(|q| (q / 60) % 5).collect();
     let opts = RefineOptions {
         max_rounds: 50,
         smoothing_time: 0.0,
