@@ -725,3 +725,69 @@ fn refine_partition_recovers_a_partition_through_a_permutation() {
         );
     }
 }
+
+/// `refine_regions` keeps the pair count and the leftover flag, partitions both shapes, and
+/// reports area fractions and objectives that match the dense affinity.
+#[test]
+fn refine_regions_rebuilds_pairs_with_dense_objectives() {
+    use coseg::stable::{RefineOptions, StableRegionsOptions, refine_regions, stable_regions};
+    let a = random_table(120, 20, 6, 71);
+    let b = noisy_copy(&random_table(100, 20, 6, 72), 0.85, 73);
+    let (areas_a, areas_b) = (random_vec(120, 74), random_vec(100, 75));
+    let w = BandAffinity::new(&a, &b).unwrap();
+    let dense = dense_affinity(&w).unwrap();
+    let opts = StableRegionsOptions {
+        pairs: 4,
+        ..Default::default()
+    };
+    let raw = stable_regions(&a, &b, &areas_a, &areas_b, &opts).unwrap();
+    let r = refine_regions(
+        &w,
+        &raw,
+        &areas_a,
+        &areas_b,
+        None,
+        None,
+        &RefineOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(r.pairs.len(), raw.pairs.len());
+    assert_partition(&r);
+    let (ta, tb): (f64, f64) = (areas_a.iter().sum(), areas_b.iter().sum());
+    for (new, old) in r.pairs.iter().zip(&raw.pairs) {
+        assert_eq!(new.leftover, old.leftover);
+        let obj = dense_objective(&dense, 120, &new.region_a, &new.region_b);
+        assert!(
+            (new.objective - obj).abs() < 1e-12 * obj.max(1e-30),
+            "{} vs {obj}",
+            new.objective
+        );
+        let fa: f64 = new
+            .region_a
+            .iter()
+            .map(|&v| areas_a[v as usize])
+            .sum::<f64>()
+            / ta;
+        let fb: f64 = new
+            .region_b
+            .iter()
+            .map(|&v| areas_b[v as usize])
+            .sum::<f64>()
+            / tb;
+        assert!(
+            (new.area_fraction_a - fa).abs() < 1e-12 && (new.area_fraction_b - fb).abs() < 1e-12
+        );
+    }
+    assert!(
+        refine_regions(
+            &w,
+            &raw,
+            &areas_a[1..],
+            &areas_b,
+            None,
+            None,
+            &RefineOptions::default()
+        )
+        .is_err()
+    );
+}

@@ -2,12 +2,14 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use coseg::affinity::BandAffinity;
 use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
 use coseg::mesh::read_mesh_with_report;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
+use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, StableRegionsOptions, TSearch, Threshold, VertexMap,
-    correspondence_ratio, stable_regions,
+    Algorithm, AreaReference, Init, RefineOptions, StableRegionsOptions, TSearch, Threshold,
+    VertexMap, correspondence_ratio, refine_regions, stable_regions,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -71,6 +73,14 @@ pub struct PairArgs {
     /// Algorithm 1's iteration cap.
     #[arg(long, default_value_t = 100)]
     max_iterations: usize,
+    /// Rounds of boundary refinement after the algorithm (smoothed best responses between the
+    /// two partitions, see `coseg::stable::refine_regions`); 0 keeps the algorithm's raw
+    /// regions.
+    #[arg(long, default_value_t = RefineOptions::default().max_rounds)]
+    refine_rounds: usize,
+    /// Heat-smoothing time of the refinement (unit-area surface; 0 = no smoothing).
+    #[arg(long, default_value_t = RefineOptions::default().smoothing_time)]
+    smoothing_time: f64,
     /// Ground truth for the correspondence ratio: `identity`, or a file with one B index per
     /// vertex of A (negative = none).
     #[arg(long)]
@@ -141,13 +151,33 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     let (ma, da) = &loaded[0];
     let (mb, db) = &loaded[1];
     let t = Instant::now();
-    let regions = stable_regions(
-        &da.bands,
-        &db.bands,
-        &ma.vertex_areas(),
-        &mb.vertex_areas(),
-        &options,
-    )?;
+    let (areas_a, areas_b) = (ma.vertex_areas(), mb.vertex_areas());
+    let mut regions = stable_regions(&da.bands, &db.bands, &areas_a, &areas_b, &options)?;
+    let refine = (args.refine_rounds > 0).then(|| RefineOptions {
+        max_rounds: args.refine_rounds,
+        smoothing_time: args.smoothing_time,
+    });
+    if let Some(refine) = &refine {
+        let smoothers = if refine.smoothing_time > 0.0 {
+            let sa = HeatSmoother::new(ma, refine.smoothing_time)
+                .with_context(|| format!("smoothing on {}", args.a.display()))?;
+            let sb = HeatSmoother::new(mb, refine.smoothing_time)
+                .with_context(|| format!("smoothing on {}", args.b.display()))?;
+            Some((sa, sb))
+        } else {
+            None
+        };
+        let w = BandAffinity::new(&da.bands, &db.bands)?;
+        regions = refine_regions(
+            &w,
+            &regions,
+            &areas_a,
+            &areas_b,
+            smoothers.as_ref().map(|s| &s.0),
+            smoothers.as_ref().map(|s| &s.1),
+            refine,
+        )?;
+    }
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
@@ -178,7 +208,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         &options,
         ratio,
         seconds,
-    );
+    )
+    .with_refine(refine);
     let shapes = [
         ShapeRegions {
             name: &na,

@@ -1,6 +1,6 @@
 //! [`PairSummary`]: the `summary.json` of a two-shape stable-region run.
 
-use crate::stable::{StableRegions, StableRegionsOptions};
+use crate::stable::{RefineOptions, StableRegions, StableRegionsOptions};
 use serde::Serialize;
 
 /// One shape of a pair run.
@@ -46,6 +46,9 @@ pub struct PairSummary {
     pub shapes: [ShapeSummary; 2],
     /// The options used.
     pub options: StableRegionsOptions,
+    /// The boundary refinement applied after the algorithm, if any (then `iterations` and
+    /// `converged` of every region report the refinement's rounds).
+    pub refine: Option<RefineOptions>,
     /// Per-region statistics, in region-id order.
     pub regions: Vec<RegionSummary>,
     /// Correspondence ratio against the given ground truth, if any (fraction in `[0, 1]`).
@@ -91,9 +94,17 @@ impl PairSummary {
         Self {
             shapes,
             options: options.clone(),
+            refine: None,
             regions,
             correspondence_ratio,
             seconds,
         }
+    }
+
+    /// Records that the regions were refined with `refine` (see
+    /// [`refine_regions`](crate::stable::refine_regions)).
+    pub fn with_refine(mut self, refine: Option<RefineOptions>) -> Self {
+        self.refine = refine;
+        self
     }
 }
