@@ -153,7 +153,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     let t = Instant::now();
     let (areas_a, areas_b) = (ma.vertex_areas(), mb.vertex_areas());
     let mut regions = stable_regions(&da.bands, &db.bands, &areas_a, &areas_b, &options)?;
-    let refine = (args.refine_rounds > 0).then(|| RefineOptions {
+    let refine = (args.refine_rounds > 0).then_some(RefineOptions {
         max_rounds: args.refine_rounds,
         smoothing_time: args.smoothing_time,
     });
