@@ -465,3 +465,112 @@ fn graph_rejects_incompatible_shapes() {
     assert!(ShapeNode::new("c", random_table(20, 8, 4, 3), &[1.0; 19]).is_err());
     assert!(ShapeNode::new("d", random_table(20, 8, 4, 3), &[0.0; 20]).is_err());
 }
+
+// ---------------------------------------------------------------------------------------------
+// Refinement over the graph
+
+/// On two shapes, refining a co-segmentation is `refine_partition` (the root is swept first,
+/// like B in `refine_partition`; one neighbour, so the edge scaling does not change the choice).
+#[test]
+fn refine_cosegmentation_of_two_shapes_is_refine_partition() {
+    use coseg::graph::refine_cosegmentation;
+    use coseg::stable::{RefineOptions, refine_partition};
+    let (tables, areas) = noisy_collection(2, 180, 5);
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    let c = cosegment(
+        &g,
+        &CosegmentOptions {
+            regions: 4,
+            root: Some(1),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let opts = RefineOptions {
+        max_rounds: 20,
+        smoothing_time: 0.0,
+    };
+    let refined = refine_cosegmentation(&g, &c, None, &opts).unwrap();
+    let w = BandAffinity::new(&tables[0], &tables[1]).unwrap();
+    let pair = refine_partition(&w, &c.labels(0), &c.labels(1), None, None, &opts).unwrap();
+    assert_eq!(refined.labels(0), pair.labels_a);
+    assert_eq!(refined.labels(1), pair.labels_b);
+    assert_eq!(refined.tuples[0].converged, pair.converged);
+    assert_eq!(refined.tuples[0].sweeps, pair.rounds);
+}
+
+/// Refinement keeps a partition, converges to a fixed point (refining again changes nothing),
+/// reports area fractions that add up to 1 and confidences in [0, 1], and is deterministic.
+#[test]
+fn refine_cosegmentation_reaches_a_fixed_point() {
+    use coseg::graph::refine_cosegmentation;
+    use coseg::stable::RefineOptions;
+    let (tables, areas) = noisy_collection(5, 200, 7);
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    let c = cosegment(
+        &g,
+        &CosegmentOptions {
+            regions: 5,
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let opts = RefineOptions {
+        max_rounds: 50,
+        smoothing_time: 0.0,
+    };
+    let r = refine_cosegmentation(&g, &c, None, &opts).unwrap();
+    assert!(r.tuples[0].converged, "no fixed point in 50 sweeps");
+    for i in 0..5 {
+        assert!(r.labels(i).iter().all(|&l| (0..5).contains(&l)));
+        let sum: f64 = r.tuples.iter().map(|t| t.area_fractions[i]).sum();
+        assert!((sum - 1.0).abs() < 1e-9);
+    }
+    assert!(r.tuples.iter().all(|t| (0.0..=1.0).contains(&t.confidence)));
+    let again = refine_cosegmentation(&g, &r, None, &opts).unwrap();
+    for i in 0..5 {
+        assert_eq!(again.labels(i), r.labels(i));
+    }
+    assert_eq!(again.tuples[0].sweeps, 1);
+    assert_eq!(refine_cosegmentation(&g, &c, None, &opts).unwrap(), r);
+}
+
+/// Vertex-permuted copies of one shape keep identical regions (through the permutations) after
+/// refinement.
+#[test]
+fn refine_cosegmentation_of_permuted_copies_agrees() {
+    use coseg::graph::refine_cosegmentation;
+    use coseg::stable::RefineOptions;
+    let d = 240;
+    let base = curve_table(d, 40, 8, 0.3, 23);
+    let perms: Vec<Vec<u32>> = (0..3)
+        .map(|i| {
+            if i == 0 {
+                all(d)
+            } else {
+                permutation(d, 70 + i)
+            }
+        })
+        .collect();
+    let areas0: Vec<f64> = random_vec(d, 19).iter().map(|x| 0.5 + x).collect();
+    let tables: Vec<BandTable> = perms.iter().map(|p| permute_table(&base, p)).collect();
+    let areas: Vec<Vec<f64>> = perms.iter().map(|p| permute_values(&areas0, p)).collect();
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    let c = cosegment(
+        &g,
+        &CosegmentOptions {
+            regions: 4,
+            root: Some(0),
+            ..Default::default()
+        },
+    )
+    .unwrap();
+    let r = refine_cosegmentation(&g, &c, None, &RefineOptions::default()).unwrap();
+    let l0 = r.labels(0);
+    for (i, p) in perms.iter().enumerate().skip(1) {
+        let li = r.labels(i);
+        let back: Vec<i32> = (0..d).map(|v| li[p[v] as usize]).collect();
+        assert_eq!(back, l0, "shape {i}");
+    }
+    assert!(refine_cosegmentation(&g, &c, Some(&[]), &RefineOptions::default()).is_err());
+}

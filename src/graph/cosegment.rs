@@ -172,8 +172,9 @@ impl Cosegmentation {
     }
 }
 
-/// Per-shape histograms and score tables: the engine of the sweeps.
-struct Engine<'g> {
+/// Per-shape histograms and score tables: the engine of the sweeps (also of
+/// [`super::refine_cosegmentation`], one engine per region).
+pub(super) struct Engine<'g> {
     graph: &'g ShapeGraph,
     bands: usize,
     /// `neighbours[i]`: `(j, edge weight, pairs as (k on j, k on i), raw pair weights)`.
@@ -194,7 +195,7 @@ struct Neighbour {
 }
 
 impl<'g> Engine<'g> {
-    fn new(graph: &'g ShapeGraph) -> Self {
+    pub(super) fn new(graph: &'g ShapeGraph) -> Self {
         let n = graph.node_count();
         let bands = graph.node(0).bands.bands;
         let neighbours = (0..n)
@@ -246,7 +247,7 @@ impl<'g> Engine<'g> {
         }
     }
 
-    fn set_region(&mut self, i: usize, region: &[u32]) {
+    pub(super) fn set_region(&mut self, i: usize, region: &[u32]) {
         let t = &self.graph.node(i).bands;
         let k = self.bands;
         let h = &mut self.hist[i];
@@ -261,7 +262,13 @@ impl<'g> Engine<'g> {
 
     /// Scores on the remaining vertices of `i` from the current regions of `sources` (all
     /// neighbours when `None`).
-    fn scores(&mut self, i: usize, sources: Option<&[usize]>, rem: &[u32], out: &mut Vec<f64>) {
+    pub(super) fn scores(
+        &mut self,
+        i: usize,
+        sources: Option<&[usize]>,
+        rem: &[u32],
+        out: &mut Vec<f64>,
+    ) {
         let t = &self.graph.node(i).bands;
         let k = self.bands;
         self.table.clear();

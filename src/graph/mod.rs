@@ -9,17 +9,21 @@
 //!   feature pairing and a weight; pairwise affinities exist only as band-table operators.
 //! - [`cosegment`]: consistent region tuples across every shape of the graph (design argued
 //!   in that function's module).
+//! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
+//!   boundaries over every edge of the graph.
 //! - [`load_collection`]: a folder of meshes to graph nodes through the per-shape cache.
 
 mod cosegment;
 mod cycle_consistency;
 mod load_collection;
+mod refine_cosegmentation;
 mod shape_graph;
 mod stable_cycle;
 
 pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
 pub use cycle_consistency::{CycleConsistency, cycle_consistency};
 pub use load_collection::{LoadedCollection, SkippedFile, load_collection, mesh_files};
+pub use refine_cosegmentation::refine_cosegmentation;
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
