@@ -3,7 +3,9 @@
 use super::{GraphError, ShapeNode};
 use crate::cache::{CacheOutcome, ShapePipelineOptions, load_or_compute};
 use crate::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// A file that could not be used, and why (the message names the file).
@@ -30,9 +32,11 @@ pub struct LoadedCollection {
     pub skipped: Vec<SkippedFile>,
     /// Warnings for the user (mesh warnings, stale cache entries, cache write failures).
     pub warnings: Vec<String>,
-    /// Time spent reading meshes.
+    /// Time spent reading meshes, summed over shapes (across threads: it can exceed the wall
+    /// time).
     pub read_time: Duration,
-    /// Time spent in the per-shape pipeline (cache reads, or spectrum + features + bands).
+    /// Time spent in the per-shape pipeline (cache reads, or spectrum + features + bands),
+    /// summed over shapes like `read_time`.
     pub shape_time: Duration,
 }
 
@@ -54,9 +58,12 @@ pub fn mesh_files(folder: &Path) -> Result<Vec<PathBuf>, GraphError> {
 }
 
 /// Reads every mesh file of `folder` ([`mesh_files`]) and gets its band table through the
-/// per-shape cache in `cache_dir` ([`crate::cache::load_or_compute`]). Files that fail to read
-/// or compute are reported in [`LoadedCollection::skipped`], not fatal. `progress(i, total,
-/// path)` is called before each file. Nodes are named by file stem.
+/// per-shape cache in `cache_dir` ([`crate::cache::load_or_compute`]). Shapes are processed in
+/// parallel on rayon's pool (one shape per thread: the per-shape work is independent, so the
+/// result is the same whatever the thread count); the result keeps file order. Files that fail
+/// to read or compute are reported in [`LoadedCollection::skipped`], not fatal.
+/// `progress(started, total, path)` is called when a file starts (from the worker threads, one
+/// call at a time). Nodes are named by file stem.
 ///
 /// ```no_run
 /// use coseg::cache::ShapePipelineOptions;
@@ -70,7 +77,7 @@ pub fn load_collection(
     folder: &Path,
     options: &ShapePipelineOptions,
     cache_dir: &Path,
-    mut progress: impl FnMut(usize, usize, &Path),
+    progress: impl FnMut(usize, usize, &Path) + Send,
 ) -> Result<LoadedCollection, GraphError> {
     let files = mesh_files(folder)?;
     let mut out = LoadedCollection {
@@ -84,61 +91,103 @@ pub fn load_collection(
         shape_time: Duration::ZERO,
     };
     let total = files.len();
-    for (i, path) in files.into_iter().enumerate() {
-        progress(i, total, &path);
-        let t = Instant::now();
-        let read = read_mesh_with_report(&path);
-        out.read_time += t.elapsed();
-        let (mesh, report) = match read {
-            Ok(x) => x,
-            Err(e) => {
-                out.skipped.push(SkippedFile {
-                    path,
-                    error: e.to_string(),
-                });
-                continue;
+    let started = Mutex::new((0usize, progress));
+    let results: Vec<ShapeResult> = files
+        .into_par_iter()
+        .enumerate()
+        .map(|(i, path)| {
+            if let Ok(mut guard) = started.lock() {
+                let (count, report) = &mut *guard;
+                report(*count, total, &path);
+                *count += 1;
             }
-        };
-        for w in &report.warnings {
-            out.warnings.push(format!("{}: {w}", path.display()));
-        }
-        let t = Instant::now();
-        let data = load_or_compute(&mesh, options, cache_dir);
-        out.shape_time += t.elapsed();
-        let res = match data {
-            Ok(r) => r,
-            Err(e) => {
-                out.skipped.push(SkippedFile {
-                    error: format!("{}: {e}", path.display()),
-                    path,
-                });
-                continue;
+            load_one(i, path, options, cache_dir)
+        })
+        .collect();
+    for r in results {
+        out.read_time += r.read_time;
+        out.shape_time += r.shape_time;
+        out.warnings.extend(r.warnings);
+        match r.outcome {
+            Err(skipped) => out.skipped.push(skipped),
+            Ok((mesh, node, outcome)) => {
+                out.paths.push(r.path);
+                out.meshes.push(mesh);
+                out.nodes.push(node);
+                out.outcomes.push(outcome);
             }
-        };
-        if let CacheOutcome::Recomputed { reason } = &res.outcome {
-            out.warnings.push(reason.clone());
         }
-        if let Some(w) = &res.write_error {
-            out.warnings.push(w.clone());
-        }
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_else(|| format!("shape{i}"));
-        let node = match ShapeNode::new(name, res.data.bands, &res.data.descriptors.vertex_areas) {
-            Ok(n) => n,
-            Err(e) => {
-                out.skipped.push(SkippedFile {
-                    error: format!("{}: {e}", path.display()),
-                    path,
-                });
-                continue;
-            }
-        };
-        out.paths.push(path);
-        out.meshes.push(mesh);
-        out.nodes.push(node);
-        out.outcomes.push(res.outcome);
     }
     Ok(out)
+}
+
+/// One file's contribution to a [`LoadedCollection`].
+struct ShapeResult {
+    path: PathBuf,
+    read_time: Duration,
+    shape_time: Duration,
+    warnings: Vec<String>,
+    outcome: Result<(TriMesh, ShapeNode, CacheOutcome), SkippedFile>,
+}
+
+fn load_one(
+    i: usize,
+    path: PathBuf,
+    options: &ShapePipelineOptions,
+    cache_dir: &Path,
+) -> ShapeResult {
+    let mut r = ShapeResult {
+        path: path.clone(),
+        read_time: Duration::ZERO,
+        shape_time: Duration::ZERO,
+        warnings: Vec::new(),
+        outcome: Err(SkippedFile {
+            path: path.clone(),
+            error: String::new(),
+        }),
+    };
+    let skip = |error: String| {
+        Err(SkippedFile {
+            path: path.clone(),
+            error,
+        })
+    };
+    let t = Instant::now();
+    let read = read_mesh_with_report(&path);
+    r.read_time = t.elapsed();
+    let (mesh, report) = match read {
+        Ok(x) => x,
+        Err(e) => {
+            r.outcome = skip(e.to_string());
+            return r;
+        }
+    };
+    for w in &report.warnings {
+        r.warnings.push(format!("{}: {w}", path.display()));
+    }
+    let t = Instant::now();
+    let data = load_or_compute(&mesh, options, cache_dir);
+    r.shape_time = t.elapsed();
+    let res = match data {
+        Ok(x) => x,
+        Err(e) => {
+            r.outcome = skip(format!("{}: {e}", path.display()));
+            return r;
+        }
+    };
+    if let CacheOutcome::Recomputed { reason } = &res.outcome {
+        r.warnings.push(reason.clone());
+    }
+    if let Some(w) = &res.write_error {
+        r.warnings.push(w.clone());
+    }
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_else(|| format!("shape{i}"));
+    r.outcome = match ShapeNode::new(name, res.data.bands, &res.data.descriptors.vertex_areas) {
+        Ok(node) => Ok((mesh, node, res.outcome)),
+        Err(e) => skip(format!("{}: {e}", path.display())),
+    };
+    r
 }

@@ -1,11 +1,11 @@
 //! [`refine_cosegmentation`]: the smoothed best-response refinement of
 //! [`refine_partition`](crate::stable::refine_partition), over every edge of a shape graph.
 
-use super::cosegment::Engine;
 use super::shape_graph::ShapeGraph;
 use super::{Cosegmentation, GraphError};
 use crate::spectral::HeatSmoother;
 use crate::stable::{RefineOptions, StableError, assign_regions};
+use rayon::prelude::*;
 
 /// Refines a co-segmentation's region ids on every shape, as
 /// [`refine_partition`](crate::stable::refine_partition) does for two shapes: in
@@ -75,46 +75,21 @@ pub fn refine_cosegmentation(
         return Ok(coseg.clone());
     }
     let stable = |e: StableError| GraphError::BadOption(e.to_string());
-    // One engine per region: engine `r` holds the band histogram of region `r` on every shape,
-    // so a shape's scores for region `r` are one mix of its neighbours' histograms and one
-    // gather over its vertices.
-    let mut engines: Vec<Engine<'_>> = (0..regions).map(|_| Engine::new(graph)).collect();
-    let members = |l: &[i32], r: usize| -> Vec<u32> {
-        (0..l.len() as u32)
-            .filter(|&v| l[v as usize] == r as i32)
-            .collect()
-    };
-    for (r, eng) in engines.iter_mut().enumerate() {
-        for (i, l) in labels.iter().enumerate() {
-            eng.set_region(i, &members(l, r));
-        }
-    }
-    let all: Vec<Vec<u32>> = coseg
-        .vertices
-        .iter()
-        .map(|&d| (0..d as u32).collect())
-        .collect();
-    let mut column = Vec::new();
+    let mut counts = RegionCounts::new(graph, regions, &labels);
+    let mut table = Vec::new();
     let (mut rounds, mut converged) = (0, false);
     while rounds < options.max_rounds {
         rounds += 1;
         let mut changed = false;
         for &i in &coseg.order {
-            let d = coseg.vertices[i];
-            let mut total = vec![0.0; d * regions];
-            for (r, eng) in engines.iter_mut().enumerate() {
-                eng.scores(i, None, &all[i], &mut column);
-                total[r * d..(r + 1) * d].copy_from_slice(&column);
-            }
+            let mut total = counts.scores(graph, i, &mut table);
             let smoother = smoothers
                 .filter(|_| options.smoothing_time > 0.0)
                 .map(|s| &s[i]);
             let (new, margin) = assign_regions(&mut total, regions, smoother).map_err(stable)?;
             if new != labels[i] {
                 changed = true;
-                for (r, eng) in engines.iter_mut().enumerate() {
-                    eng.set_region(i, &members(&new, r));
-                }
+                counts.relabel(graph, i, &labels[i], &new);
                 labels[i] = new;
             }
             margins[i] = margin;
@@ -151,4 +126,127 @@ pub fn refine_cosegmentation(
         };
     }
     Ok(out)
+}
+
+/// Per-shape band counts of every region at once, laid out `[(feature · K + band) · R + r]`,
+/// so that one pass over a shape's band table scores all `R` regions (each table read brings
+/// the `R` region entries of one band in one cache line).
+struct RegionCounts {
+    regions: usize,
+    bands: usize,
+    /// `counts[i]`: `N_i · K · R` counts (exact integers in `f64`).
+    counts: Vec<Vec<f64>>,
+    /// `sizes[i][r]`: vertices of region `r` on shape `i`.
+    sizes: Vec<Vec<usize>>,
+}
+
+impl RegionCounts {
+    fn new(graph: &ShapeGraph, regions: usize, labels: &[Vec<i32>]) -> Self {
+        let bands = graph.node(0).bands.bands;
+        let mut rc = RegionCounts {
+            regions,
+            bands,
+            counts: Vec::with_capacity(labels.len()),
+            sizes: Vec::with_capacity(labels.len()),
+        };
+        for (i, l) in labels.iter().enumerate() {
+            let t = &graph.node(i).bands;
+            rc.counts.push(vec![0.0; t.features * bands * regions]);
+            rc.sizes.push(vec![0; regions]);
+            let none = vec![-1; l.len()];
+            rc.relabel(graph, i, &none, l);
+        }
+        rc
+    }
+
+    /// Moves the vertices of shape `i` whose label changes from `old` to `new`.
+    fn relabel(&mut self, graph: &ShapeGraph, i: usize, old: &[i32], new: &[i32]) {
+        let t = &graph.node(i).bands;
+        let (k, r) = (self.bands, self.regions);
+        let c = &mut self.counts[i];
+        let in_range = |l: i32| l >= 0 && (l as usize) < r;
+        for (v, (&lo, &ln)) in old.iter().zip(new).enumerate() {
+            if lo == ln {
+                continue;
+            }
+            let row = t.row(v);
+            if in_range(lo) {
+                self.sizes[i][lo as usize] -= 1;
+                for (f, &b) in row.iter().enumerate() {
+                    c[(f * k + b as usize) * r + lo as usize] -= 1.0;
+                }
+            }
+            if in_range(ln) {
+                self.sizes[i][ln as usize] += 1;
+                for (f, &b) in row.iter().enumerate() {
+                    c[(f * k + b as usize) * r + ln as usize] += 1.0;
+                }
+            }
+        }
+    }
+
+    /// Scores of every vertex of shape `i` for every region, column-major `d_i × R`:
+    /// `Σ_{j ~ i} w_ij · (R_ij 1_{F_j,r})_q / (N_ij |F_j,r|)` (edge pair weights normalised to
+    /// mean 1, as in `cosegment`).
+    fn scores(&self, graph: &ShapeGraph, i: usize, table: &mut Vec<f64>) -> Vec<f64> {
+        let t = &graph.node(i).bands;
+        let (k, r) = (self.bands, self.regions);
+        table.clear();
+        table.resize(t.features * k * r, 0.0);
+        let mut scale = vec![0.0; r];
+        for (j, edge) in graph.neighbours(i) {
+            let np = edge.pairs.len().max(1) as f64;
+            for (s, &n) in scale.iter_mut().zip(&self.sizes[j]) {
+                *s = if n > 0 {
+                    edge.weight / (np * n as f64)
+                } else {
+                    0.0
+                };
+            }
+            let weight_sum: f64 = edge.pair_weights.as_ref().map_or(np, |w| w.iter().sum());
+            let h = &self.counts[j];
+            for (p, &(lo, hi)) in edge.pairs.iter().enumerate() {
+                // Feature `ka` on `j`, `kb` on `i`.
+                let (ka, kb) = if j < i {
+                    (lo as usize, hi as usize)
+                } else {
+                    (hi as usize, lo as usize)
+                };
+                let raw = edge
+                    .pair_weights
+                    .as_ref()
+                    .map_or(1.0, |w| w[p] / weight_sum * np);
+                let src = &h[ka * k * r..(ka + 1) * k * r];
+                let dst = &mut table[kb * k * r..(kb + 1) * k * r];
+                for (band_dst, band_src) in dst.chunks_exact_mut(r).zip(src.chunks_exact(r)) {
+                    for ((d, &s), &c) in band_dst.iter_mut().zip(band_src).zip(&scale) {
+                        *d += raw * c * s;
+                    }
+                }
+            }
+        }
+        let d = t.vertices;
+        let mut rows = vec![0.0; d * r];
+        let table = &*table;
+        rows.par_chunks_mut(512 * r)
+            .enumerate()
+            .for_each(|(chunk, out)| {
+                for (o, q) in out.chunks_exact_mut(r).zip(chunk * 512..) {
+                    for (f, &b) in t.row(q).iter().enumerate() {
+                        let base = (f * k + b as usize) * r;
+                        for (acc, &x) in o.iter_mut().zip(&table[base..base + r]) {
+                            *acc += x;
+                        }
+                    }
+                }
+            });
+        // Vertex-major rows to region columns.
+        let mut cols = vec![0.0; d * r];
+        for (q, row) in rows.chunks_exact(r).enumerate() {
+            for (c, &x) in row.iter().enumerate() {
+                cols[c * d + q] = x;
+            }
+        }
+        cols
+    }
 }
