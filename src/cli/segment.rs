@@ -1,14 +1,16 @@
+//! `coseg segment FOLDER -o OUT`: consistent co-segmentation of every mesh in a folder.
+
 use anyhow::{Context, Result, bail};
 use clap::Args;
-use coseg::cache::{CacheOutcome, ShapePipelineOptions};
+use coseg::cache::CacheOutcome;
 use coseg::graph::{
-    CosegmentOptions, Cosegmentation, GraphKind, GraphOptions, LoadedCollection, ShapeGraph,
-    cosegment, load_collection,
+    CosegmentOptions, GraphOptions, SegmentCollectionOptions, load_collection, segment_collection,
 };
-use coseg::mesh::{PlyVertexProperty, write_mesh};
+use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions};
+use coseg::stable::RefineOptions;
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -16,7 +18,8 @@ use std::time::Instant;
 pub struct SegmentArgs {
     /// Folder of meshes (.obj, .off, .ply); every mesh file directly in it is used.
     folder: PathBuf,
-    /// Output folder: `<name>.regions.txt`, `<name>.ply` (coloured) per shape, `summary.json`.
+    /// Output folder: `<name>.regions.txt`, `<name>.regions.ply` (coloured) per shape,
+    /// `summary.json`.
     #[arg(short, long)]
     out: PathBuf,
     /// Per-shape cache folder (default: `<OUT>/.cache`).
@@ -39,6 +42,15 @@ pub struct SegmentArgs {
     /// Neighbours per shape of the nearest-neighbour graph.
     #[arg(long, default_value_t = GraphOptions::default().neighbours)]
     neighbours: usize,
+    /// Sweeps of boundary refinement after the co-segmentation (smoothed best responses over
+    /// every graph edge, see `coseg::graph::refine_cosegmentation`); 0 keeps the raw regions.
+    #[arg(long, default_value_t = SegmentCollectionOptions::DEFAULT_REFINE.max_rounds)]
+    refine_rounds: usize,
+    /// Heat-smoothing time of the refinement (unit-area surface; 0 = no smoothing).
+    #[arg(long, default_value_t = SegmentCollectionOptions::DEFAULT_REFINE.smoothing_time)]
+    smoothing_time: f64,
+    #[command(flatten)]
+    pipeline: super::pipeline_args::PipelineArgs,
 }
 
 pub fn run(args: SegmentArgs) -> Result<ExitCode> {
@@ -46,18 +58,16 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         .cache
         .clone()
         .unwrap_or_else(|| args.out.join(".cache"));
-    let pipeline = ShapePipelineOptions::default();
+    let pipeline = args.pipeline.options();
     let t0 = Instant::now();
-    let bar = if std::io::stderr().is_terminal() {
+    let bar = std::io::stderr().is_terminal().then(|| {
         let b = ProgressBar::new(0);
         b.set_style(
             ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        Some(b)
-    } else {
-        None
-    };
+        b
+    });
     let loaded = load_collection(&args.folder, &pipeline, &cache, |i, total, path| {
         if let Some(b) = &bar {
             b.set_length(total as u64);
@@ -89,25 +99,53 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             loaded.nodes.len()
         );
     }
-    let t_graph = Instant::now();
-    let graph_opts = GraphOptions {
-        complete_limit: args.complete_limit,
-        neighbours: args.neighbours,
-        ..Default::default()
+    let options = SegmentCollectionOptions {
+        graph: GraphOptions {
+            complete_limit: args.complete_limit,
+            neighbours: args.neighbours,
+            ..Default::default()
+        },
+        cosegment: CosegmentOptions {
+            regions: args.regions,
+            area_fraction: args.area_fraction,
+            seed: args.seed,
+            ..Default::default()
+        },
+        refine: (args.refine_rounds > 0).then_some(RefineOptions {
+            max_rounds: args.refine_rounds,
+            smoothing_time: args.smoothing_time,
+        }),
     };
-    let graph = ShapeGraph::build(loaded.nodes.clone(), &graph_opts)?;
-    let graph_time = t_graph.elapsed();
-    let t_seg = Instant::now();
-    let opts = CosegmentOptions {
-        regions: args.regions,
-        area_fraction: args.area_fraction,
-        seed: args.seed,
-        ..Default::default()
-    };
-    let seg = cosegment(&graph, &opts)?;
-    let seg_time = t_seg.elapsed();
+    let result = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?;
+    let seg = &result.segmentation;
     let t_write = Instant::now();
-    write_results(&args.out, &loaded, &graph, &seg)?;
+    let files: Vec<String> = loaded
+        .paths
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    let skipped = loaded
+        .skipped
+        .iter()
+        .map(|s| SkippedInput {
+            path: s.path.display().to_string(),
+            error: s.error.clone(),
+        })
+        .collect();
+    let summary = CollectionSummary::new(&result, &files, &options, skipped);
+    let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
+    let shapes: Vec<ShapeRegions> = seg
+        .names
+        .iter()
+        .zip(&loaded.meshes)
+        .zip(&labels)
+        .map(|((name, mesh), regions)| ShapeRegions {
+            name,
+            mesh,
+            regions,
+        })
+        .collect();
+    let written = write_regions(&args.out, &shapes, &summary)?;
     let write_time = t_write.elapsed();
     let hits = loaded
         .outcomes
@@ -115,121 +153,30 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         .filter(|o| **o == CacheOutcome::Hit)
         .count();
     println!(
-        "{} shapes co-segmented into {} regions; results in {}",
+        "{} shapes co-segmented into {} regions; {} files in {}",
         loaded.nodes.len(),
         seg.tuples.len(),
+        written.len(),
         args.out.display()
     );
+    let times = &result.times;
     println!(
-        "time: read {:.2} s, per-shape data {:.2} s ({hits} cached), graph {:.2} s, co-segmentation {:.2} s, write {:.2} s, total {:.2} s",
+        "time: read {:.2} s, per-shape data {:.2} s ({hits} cached), graph {:.2} s, co-segmentation {:.2} s, refinement {:.2} s{}, write {:.2} s, total {:.2} s",
         loaded.read_time.as_secs_f64(),
         loaded.shape_time.as_secs_f64(),
-        graph_time.as_secs_f64(),
-        seg_time.as_secs_f64(),
+        times.graph.as_secs_f64(),
+        times.cosegment.as_secs_f64(),
+        (times.smoothers + times.refine).as_secs_f64(),
+        match (&options.refine, seg.tuples.first()) {
+            (Some(_), Some(t)) => format!(
+                " ({} sweeps{})",
+                t.sweeps,
+                if t.converged { ", converged" } else { "" }
+            ),
+            _ => String::new(),
+        },
         write_time.as_secs_f64(),
         t0.elapsed().as_secs_f64()
     );
     Ok(super::exit_code(loaded.skipped.len(), total_files))
-}
-
-/// A distinct colour per region id (golden-ratio hues; id `-1` grey).
-fn colour(id: i32) -> [u8; 3] {
-    if id < 0 {
-        return [128, 128, 128];
-    }
-    let h = (id as f64 * 0.618_033_988_749_895).fract() * 6.0;
-    let (s, v) = (0.65, 0.95);
-    let c = v * s;
-    let x = c * (1.0 - ((h % 2.0) - 1.0).abs());
-    let (r, g, b) = match h as u32 {
-        0 => (c, x, 0.0),
-        1 => (x, c, 0.0),
-        2 => (0.0, c, x),
-        3 => (0.0, x, c),
-        4 => (x, 0.0, c),
-        _ => (c, 0.0, x),
-    };
-    let m = v - c;
-    [r, g, b].map(|u| ((u + m) * 255.0).round() as u8)
-}
-
-/// Writes `<name>.regions.txt` (one region id per line, vertex order of the input file),
-/// `<name>.ply` (coloured, with an int `region` property) and `summary.json`. Kept in one place
-/// to switch to the shared writers of `coseg::output` once they exist.
-fn write_results(
-    out: &Path,
-    loaded: &LoadedCollection,
-    graph: &ShapeGraph,
-    seg: &Cosegmentation,
-) -> Result<()> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
-    let mut shapes = Vec::new();
-    for (i, name) in seg.names.iter().enumerate() {
-        let labels = seg.labels(i);
-        let mut text = String::with_capacity(labels.len() * 3);
-        for l in &labels {
-            text.push_str(&l.to_string());
-            text.push('\n');
-        }
-        let regions_file = out.join(format!("{name}.regions.txt"));
-        std::fs::write(&regions_file, text)
-            .with_context(|| format!("writing {}", regions_file.display()))?;
-        let ply = out.join(format!("{name}.ply"));
-        write_mesh(
-            &ply,
-            &loaded.meshes[i],
-            &[
-                PlyVertexProperty::Color(labels.iter().map(|&l| colour(l)).collect()),
-                PlyVertexProperty::Int("region".into(), labels.clone()),
-            ],
-        )?;
-        shapes.push(serde_json::json!({
-            "name": name,
-            "input": loaded.paths[i].display().to_string(),
-            "vertices": seg.vertices[i],
-            "regions_file": regions_file.display().to_string(),
-            "mesh_file": ply.display().to_string(),
-            "region_area_fractions": seg.tuples.iter().map(|t| t.area_fractions[i]).collect::<Vec<_>>(),
-        }));
-    }
-    let regions: Vec<_> = seg
-        .tuples
-        .iter()
-        .enumerate()
-        .map(|(r, t)| {
-            serde_json::json!({
-                "id": r,
-                "leftover": t.leftover,
-                "confidence": t.confidence,
-                "cycle_consistency": t.cycle_consistency,
-                "converged": t.converged,
-                "sweeps": t.sweeps,
-                "objective": t.objective,
-            })
-        })
-        .collect();
-    let kind = match graph.kind() {
-        GraphKind::Complete => "complete".to_string(),
-        GraphKind::Nearest(k) => format!("nearest-{k}"),
-    };
-    let summary = serde_json::json!({
-        "command": "segment",
-        "shapes": shapes,
-        "regions": regions,
-        "area_fraction": seg.alpha,
-        "root": seg.names[seg.root],
-        "graph": {
-            "kind": kind,
-            "edges": graph.edges().iter().map(|(i, j, e)| serde_json::json!({
-                "a": seg.names[*i], "b": seg.names[*j], "weight": e.weight, "distance": e.distance
-            })).collect::<Vec<_>>(),
-        },
-        "skipped": loaded.skipped.iter().map(|s| serde_json::json!({
-            "path": s.path.display().to_string(), "error": s.error
-        })).collect::<Vec<_>>(),
-    });
-    let path = out.join("summary.json");
-    std::fs::write(&path, serde_json::to_string_pretty(&summary)? + "\n")
-        .with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
 }

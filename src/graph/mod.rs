@@ -11,12 +11,15 @@
 //!   in that function's module).
 //! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
 //!   boundaries over every edge of the graph.
+//! - [`segment_collection`]: graph, co-segmentation and refinement in one call, as
+//!   `coseg segment` runs them.
 //! - [`load_collection`]: a folder of meshes to graph nodes through the per-shape cache.
 
 mod cosegment;
 mod cycle_consistency;
 mod load_collection;
 mod refine_cosegmentation;
+mod segment_collection;
 mod shape_graph;
 mod stable_cycle;
 
@@ -24,6 +27,9 @@ pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, co
 pub use cycle_consistency::{CycleConsistency, cycle_consistency};
 pub use load_collection::{LoadedCollection, SkippedFile, load_collection, mesh_files};
 pub use refine_cosegmentation::refine_cosegmentation;
+pub use segment_collection::{
+    SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection,
+};
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
@@ -48,6 +54,15 @@ pub enum GraphError {
         name: String,
         /// What does not match.
         reason: String,
+    },
+    /// A shape's heat smoother (for the refinement) could not be built.
+    #[error("shape {name}: heat smoothing: {source}")]
+    Smoothing {
+        /// The shape's name.
+        name: String,
+        /// The spectral-stage error.
+        #[source]
+        source: crate::spectral::SpectralError,
     },
     /// The collection folder could not be listed.
     #[error("{path}: {source}")]

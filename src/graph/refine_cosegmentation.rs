@@ -76,7 +76,7 @@ pub fn refine_cosegmentation(
     }
     let stable = |e: StableError| GraphError::BadOption(e.to_string());
     let mut counts = RegionCounts::new(graph, regions, &labels);
-    let mut table = Vec::new();
+    let mut table: Vec<Block> = Vec::new();
     let (mut rounds, mut converged) = (0, false);
     while rounds < options.max_rounds {
         rounds += 1;
@@ -128,14 +128,24 @@ pub fn refine_cosegmentation(
     Ok(out)
 }
 
-/// Per-shape band counts of every region at once, laid out `[(feature · K + band) · R + r]`,
-/// so that one pass over a shape's band table scores all `R` regions (each table read brings
-/// the `R` region entries of one band in one cache line).
+/// Regions are processed in blocks of this many lanes, each block an `[f32; LANES]` that the
+/// gather keeps in one vector register. The tables are `f32`: the gather reads one block per
+/// (vertex, feature) and is bound by cache bandwidth, and single precision halves it; scores
+/// are sums of 300-odd non-negative terms of similar size, far from `f32`'s limits.
+const LANES: usize = 8;
+
+/// `LANES` regions' values for one (feature, band).
+type Block = [f32; LANES];
+
+/// Per-shape band counts of every region at once, as region blocks laid out
+/// `[(block · N + feature) · K + band]`, so that one pass over a shape's band table scores
+/// `LANES` regions per table read.
 struct RegionCounts {
     regions: usize,
+    blocks: usize,
     bands: usize,
-    /// `counts[i]`: `N_i · K · R` counts (exact integers in `f64`).
-    counts: Vec<Vec<f64>>,
+    /// `counts[i]`: `blocks · N_i · K` blocks of counts (exact integers in `f32`: below 2²⁴).
+    counts: Vec<Vec<Block>>,
     /// `sizes[i][r]`: vertices of region `r` on shape `i`.
     sizes: Vec<Vec<usize>>,
 }
@@ -143,15 +153,18 @@ struct RegionCounts {
 impl RegionCounts {
     fn new(graph: &ShapeGraph, regions: usize, labels: &[Vec<i32>]) -> Self {
         let bands = graph.node(0).bands.bands;
+        let blocks = regions.div_ceil(LANES);
         let mut rc = RegionCounts {
             regions,
+            blocks,
             bands,
             counts: Vec::with_capacity(labels.len()),
             sizes: Vec::with_capacity(labels.len()),
         };
         for (i, l) in labels.iter().enumerate() {
             let t = &graph.node(i).bands;
-            rc.counts.push(vec![0.0; t.features * bands * regions]);
+            rc.counts
+                .push(vec![[0.0; LANES]; blocks * t.features * bands]);
             rc.sizes.push(vec![0; regions]);
             let none = vec![-1; l.len()];
             rc.relabel(graph, i, &none, l);
@@ -162,25 +175,28 @@ impl RegionCounts {
     /// Moves the vertices of shape `i` whose label changes from `old` to `new`.
     fn relabel(&mut self, graph: &ShapeGraph, i: usize, old: &[i32], new: &[i32]) {
         let t = &graph.node(i).bands;
-        let (k, r) = (self.bands, self.regions);
+        let (k, nf, r) = (self.bands, t.features, self.regions);
         let c = &mut self.counts[i];
-        let in_range = |l: i32| l >= 0 && (l as usize) < r;
+        let mut update = |v: usize, label: i32, delta: f32| {
+            if label < 0 || label as usize >= r {
+                return false;
+            }
+            let (block, lane) = (label as usize / LANES, label as usize % LANES);
+            let base = block * nf * k;
+            for (f, &b) in t.row(v).iter().enumerate() {
+                c[base + f * k + b as usize][lane] += delta;
+            }
+            true
+        };
         for (v, (&lo, &ln)) in old.iter().zip(new).enumerate() {
             if lo == ln {
                 continue;
             }
-            let row = t.row(v);
-            if in_range(lo) {
+            if update(v, lo, -1.0) {
                 self.sizes[i][lo as usize] -= 1;
-                for (f, &b) in row.iter().enumerate() {
-                    c[(f * k + b as usize) * r + lo as usize] -= 1.0;
-                }
             }
-            if in_range(ln) {
+            if update(v, ln, 1.0) {
                 self.sizes[i][ln as usize] += 1;
-                for (f, &b) in row.iter().enumerate() {
-                    c[(f * k + b as usize) * r + ln as usize] += 1.0;
-                }
             }
         }
     }
@@ -188,16 +204,18 @@ impl RegionCounts {
     /// Scores of every vertex of shape `i` for every region, column-major `d_i × R`:
     /// `Σ_{j ~ i} w_ij · (R_ij 1_{F_j,r})_q / (N_ij |F_j,r|)` (edge pair weights normalised to
     /// mean 1, as in `cosegment`).
-    fn scores(&self, graph: &ShapeGraph, i: usize, table: &mut Vec<f64>) -> Vec<f64> {
+    fn scores(&self, graph: &ShapeGraph, i: usize, table: &mut Vec<Block>) -> Vec<f64> {
         let t = &graph.node(i).bands;
-        let (k, r) = (self.bands, self.regions);
+        let (k, r, blocks) = (self.bands, self.regions, self.blocks);
+        let nf_i = t.features;
         table.clear();
-        table.resize(t.features * k * r, 0.0);
-        let mut scale = vec![0.0; r];
+        table.resize(blocks * nf_i * k, [0.0; LANES]);
+        let mut scale = vec![0.0f64; blocks * LANES];
         for (j, edge) in graph.neighbours(i) {
+            let nf_j = graph.node(j).bands.features;
             let np = edge.pairs.len().max(1) as f64;
-            for (s, &n) in scale.iter_mut().zip(&self.sizes[j]) {
-                *s = if n > 0 {
+            for (c, &n) in scale.iter_mut().zip(&self.sizes[j]) {
+                *c = if n > 0 {
                     edge.weight / (np * n as f64)
                 } else {
                     0.0
@@ -216,35 +234,47 @@ impl RegionCounts {
                     .pair_weights
                     .as_ref()
                     .map_or(1.0, |w| w[p] / weight_sum * np);
-                let src = &h[ka * k * r..(ka + 1) * k * r];
-                let dst = &mut table[kb * k * r..(kb + 1) * k * r];
-                for (band_dst, band_src) in dst.chunks_exact_mut(r).zip(src.chunks_exact(r)) {
-                    for ((d, &s), &c) in band_dst.iter_mut().zip(band_src).zip(&scale) {
-                        *d += raw * c * s;
+                for block in 0..blocks {
+                    let mut scaled: Block = [0.0; LANES];
+                    for (l, x) in scaled.iter_mut().enumerate() {
+                        *x = (raw * scale[block * LANES + l]) as f32;
+                    }
+                    let src = &h[(block * nf_j + ka) * k..][..k];
+                    let dst = &mut table[(block * nf_i + kb) * k..][..k];
+                    for (d, s) in dst.iter_mut().zip(src) {
+                        for l in 0..LANES {
+                            d[l] += scaled[l] * s[l];
+                        }
                     }
                 }
             }
         }
         let d = t.vertices;
-        let mut rows = vec![0.0; d * r];
+        let mut rows: Vec<Block> = vec![[0.0; LANES]; d * blocks];
         let table = &*table;
-        rows.par_chunks_mut(512 * r)
+        rows.par_chunks_mut(512 * blocks)
             .enumerate()
             .for_each(|(chunk, out)| {
-                for (o, q) in out.chunks_exact_mut(r).zip(chunk * 512..) {
-                    for (f, &b) in t.row(q).iter().enumerate() {
-                        let base = (f * k + b as usize) * r;
-                        for (acc, &x) in o.iter_mut().zip(&table[base..base + r]) {
-                            *acc += x;
+                for (o, q) in out.chunks_exact_mut(blocks).zip(chunk * 512..) {
+                    let row = t.row(q);
+                    for (block, acc) in o.iter_mut().enumerate() {
+                        let part = &table[block * nf_i * k..][..nf_i * k];
+                        let mut sum: Block = [0.0; LANES];
+                        for (features, &b) in part.chunks_exact(k).zip(row) {
+                            let x = &features[b as usize];
+                            for l in 0..LANES {
+                                sum[l] += x[l];
+                            }
                         }
+                        *acc = sum;
                     }
                 }
             });
-        // Vertex-major rows to region columns.
+        // Vertex-major blocks to region columns.
         let mut cols = vec![0.0; d * r];
-        for (q, row) in rows.chunks_exact(r).enumerate() {
-            for (c, &x) in row.iter().enumerate() {
-                cols[c * d + q] = x;
+        for (q, row) in rows.chunks_exact(blocks).enumerate() {
+            for (c, col) in cols.chunks_exact_mut(d).enumerate() {
+                col[q] = f64::from(row[c / LANES][c % LANES]);
             }
         }
         cols

@@ -10,10 +10,14 @@
 //!   integer `region` vertex property.
 //! - `OUT/summary.json`: the summary, pretty-printed.
 
+mod collection_summary;
 mod pair_summary;
 mod region_colors;
 mod write_regions;
 
+pub use collection_summary::{
+    CollectionEdge, CollectionRegion, CollectionShape, CollectionSummary, SkippedInput,
+};
 pub use pair_summary::{PairSummary, RegionSummary, ShapeSummary};
 pub use region_colors::region_colors;
 pub use write_regions::{
