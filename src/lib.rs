@@ -18,11 +18,13 @@
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
 //! | output | [`output`] | region files, coloured meshes, summaries |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
+//! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
 #![deny(missing_docs)]
 
 pub mod affinity;
 pub mod bands;
 pub mod cache;
+pub mod evaluate;
 pub mod features;
 pub mod generate;
 pub mod graph;
