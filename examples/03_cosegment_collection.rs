@@ -4,19 +4,17 @@
 //! cargo run --release --example 03_cosegment_collection -- quadrupeds   # or humanoids, goblets, chairs
 //! ```
 //!
-//! Every shape of `collections/<family>/` is loaded through the per-shape cache; a shape graph
-//! links them; `cosegment` finds region tuples (region `r` is the same part on every shape) and
-//! `refine_cosegmentation` cleans their boundaries. Purity: how much of each region lies in one
+//! Every shape of `collections/<family>/` is loaded through the per-shape cache;
+//! `segment_collection` links them in a shape graph, finds region tuples with `cosegment`
+//! (region `r` is the same part on every shape) and cleans their boundaries with
+//! `refine_cosegmentation`, exactly as `coseg segment` does. Purity: how much of each region lies in one
 //! ground-truth part. Coverage: how much of each part one region covers, on all shapes at once.
 
 use coseg::cache::ShapePipelineOptions;
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
 use coseg::graph::{
-    CosegmentOptions, Cosegmentation, GraphOptions, LoadedCollection, ShapeGraph, cosegment,
-    load_collection, refine_cosegmentation,
+    Cosegmentation, LoadedCollection, SegmentCollectionOptions, load_collection, segment_collection,
 };
-use coseg::spectral::HeatSmoother;
-use coseg::stable::RefineOptions;
 use std::path::PathBuf;
 
 fn score(
@@ -51,17 +49,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for skipped in &loaded.skipped {
         eprintln!("skipped: {}", skipped.error);
     }
-    let graph = ShapeGraph::build(loaded.nodes.clone(), &GraphOptions::default())?;
 
-    // Region tuples across the family, then boundary refinement over every graph edge.
-    let seg = cosegment(&graph, &CosegmentOptions::default())?;
-    let refine = RefineOptions::default();
-    let smoothers = loaded
-        .meshes
-        .iter()
-        .map(|m| HeatSmoother::new(m, refine.smoothing_time))
-        .collect::<Result<Vec<_>, _>>()?;
-    let refined = refine_cosegmentation(&graph, &seg, Some(&smoothers), &refine)?;
+    // Region tuples across the family, then boundary refinement over every graph edge (the
+    // defaults); and, for comparison, the raw tuples.
+    let options = SegmentCollectionOptions::default();
+    let refined = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?.segmentation;
+    let raw = SegmentCollectionOptions {
+        refine: None,
+        ..options
+    };
+    let seg = segment_collection(loaded.nodes.clone(), &loaded.meshes, &raw)?.segmentation;
 
     println!(
         "{family}: {} shapes, {} regions, root {}",

@@ -471,32 +471,41 @@ fn graph_rejects_incompatible_shapes() {
 
 /// On two shapes, refining a co-segmentation is `refine_partition` (the root is swept first,
 /// like B in `refine_partition`; one neighbour, so the edge scaling does not change the choice).
+///
+/// 11 regions take two blocks of the refinement's region tables (8 lanes each), so the padded
+/// second block is checked too.
 #[test]
 fn refine_cosegmentation_of_two_shapes_is_refine_partition() {
     use coseg::graph::refine_cosegmentation;
     use coseg::stable::{RefineOptions, refine_partition};
-    let (tables, areas) = noisy_collection(2, 180, 5);
-    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
-    let c = cosegment(
-        &g,
-        &CosegmentOptions {
-            regions: 4,
-            root: Some(1),
-            ..Default::default()
-        },
-    )
-    .unwrap();
-    let opts = RefineOptions {
-        max_rounds: 20,
-        smoothing_time: 0.0,
-    };
-    let refined = refine_cosegmentation(&g, &c, None, &opts).unwrap();
-    let w = BandAffinity::new(&tables[0], &tables[1]).unwrap();
-    let pair = refine_partition(&w, &c.labels(0), &c.labels(1), None, None, &opts).unwrap();
-    assert_eq!(refined.labels(0), pair.labels_a);
-    assert_eq!(refined.labels(1), pair.labels_b);
-    assert_eq!(refined.tuples[0].converged, pair.converged);
-    assert_eq!(refined.tuples[0].sweeps, pair.rounds);
+    for (regions, seed) in [(4, 5), (11, 6)] {
+        let (tables, areas) = noisy_collection(2, 180, seed);
+        let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+        let c = cosegment(
+            &g,
+            &CosegmentOptions {
+                regions,
+                root: Some(1),
+                ..Default::default()
+            },
+        )
+        .unwrap();
+        let opts = RefineOptions {
+            max_rounds: 20,
+            smoothing_time: 0.0,
+        };
+        let refined = refine_cosegmentation(&g, &c, None, &opts).unwrap();
+        let w = BandAffinity::new(&tables[0], &tables[1]).unwrap();
+        let pair = refine_partition(&w, &c.labels(0), &c.labels(1), None, None, &opts).unwrap();
+        assert_eq!(refined.labels(0), pair.labels_a, "{regions} regions");
+        assert_eq!(refined.labels(1), pair.labels_b, "{regions} regions");
+        assert_eq!(refined.tuples[0].converged, pair.converged);
+        assert_eq!(refined.tuples[0].sweeps, pair.rounds);
+        assert!(
+            pair.rounds > 1,
+            "{regions} regions: the refinement changed nothing"
+        );
+    }
 }
 
 /// Refinement keeps a partition, converges to a fixed point (refining again changes nothing),
@@ -573,4 +582,43 @@ fn refine_cosegmentation_of_permuted_copies_agrees() {
         assert_eq!(back, l0, "shape {i}");
     }
     assert!(refine_cosegmentation(&g, &c, Some(&[]), &RefineOptions::default()).is_err());
+}
+
+// The one-call collection stage
+
+/// `segment_collection` is exactly graph → `cosegment` → smoothers → `refine_cosegmentation`
+/// (and just the first two without refinement); it rejects meshes that do not match.
+#[test]
+fn segment_collection_is_cosegment_then_refinement() {
+    use coseg::graph::{SegmentCollectionOptions, refine_cosegmentation, segment_collection};
+    use coseg::spectral::HeatSmoother;
+    use coseg::stable::RefineOptions;
+    let mesh = common::shapes::icosphere(2, 1.0);
+    let d = mesh.vertex_count();
+    let (tables, areas) = noisy_collection(4, d, 11);
+    let meshes = vec![mesh; 4];
+    let mut opts = SegmentCollectionOptions {
+        refine: None,
+        ..Default::default()
+    };
+    opts.cosegment.regions = 4;
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &opts.graph).unwrap();
+    let raw = cosegment(&g, &opts.cosegment).unwrap();
+    let out = segment_collection(nodes_from(&tables, &areas), &[], &opts).unwrap();
+    assert_eq!(out.segmentation, raw);
+
+    let refine = RefineOptions {
+        max_rounds: 7,
+        smoothing_time: 0.01,
+    };
+    opts.refine = Some(refine.clone());
+    let smoothers: Vec<HeatSmoother> = meshes
+        .iter()
+        .map(|m| HeatSmoother::new(m, refine.smoothing_time).unwrap())
+        .collect();
+    let expected = refine_cosegmentation(&g, &raw, Some(&smoothers), &refine).unwrap();
+    let out = segment_collection(nodes_from(&tables, &areas), &meshes, &opts).unwrap();
+    assert_eq!(out.segmentation, expected);
+    assert!(out.segmentation != raw, "the refinement changed nothing");
+    assert!(segment_collection(nodes_from(&tables, &areas), &meshes[..3], &opts).is_err());
 }
