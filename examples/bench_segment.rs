@@ -33,7 +33,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             "--refine-rounds" => {
                 let rounds: usize = args.next().ok_or("--refine-rounds N")?.parse()?;
-                seg_opts.refine = (rounds > 0).then(|| coseg::stable::RefineOptions {
+                seg_opts.refine = (rounds > 0).then_some(coseg::stable::RefineOptions {
                     max_rounds: rounds,
                     ..SegmentCollectionOptions::DEFAULT_REFINE
                 });
