@@ -150,6 +150,36 @@ struct RegionCounts {
     sizes: Vec<Vec<usize>>,
 }
 
+/// `Σ_f part[f K + row[f]]` over blocks, in four interleaved partial sums (features
+/// `f ≡ 0, 1, 2, 3 mod 4`, combined as `(s0 + s1) + (s2 + s3)`) so that consecutive additions
+/// do not wait for each other.
+#[inline]
+fn block_row_sum(part: &[Block], row: &[u8], k: usize) -> Block {
+    let mut acc = [[0.0f32; LANES]; 4];
+    let quads = row.chunks_exact(4);
+    let tail = quads.remainder();
+    for (tf, rf) in part.chunks_exact(4 * k).zip(quads) {
+        for (j, a) in acc.iter_mut().enumerate() {
+            let x = &tf[j * k + rf[j] as usize];
+            for l in 0..LANES {
+                a[l] += x[l];
+            }
+        }
+    }
+    let start = row.len() - tail.len();
+    for (f, &b) in tail.iter().enumerate() {
+        let x = &part[(start + f) * k + b as usize];
+        for l in 0..LANES {
+            acc[0][l] += x[l];
+        }
+    }
+    let mut out = [0.0f32; LANES];
+    for (l, o) in out.iter_mut().enumerate() {
+        *o = (acc[0][l] + acc[1][l]) + (acc[2][l] + acc[3][l]);
+    }
+    out
+}
+
 impl RegionCounts {
     fn new(graph: &ShapeGraph, regions: usize, labels: &[Vec<i32>]) -> Self {
         let bands = graph.node(0).bands.bands;
@@ -258,15 +288,7 @@ impl RegionCounts {
                 for (o, q) in out.chunks_exact_mut(blocks).zip(chunk * 512..) {
                     let row = t.row(q);
                     for (block, acc) in o.iter_mut().enumerate() {
-                        let part = &table[block * nf_i * k..][..nf_i * k];
-                        let mut sum: Block = [0.0; LANES];
-                        for (features, &b) in part.chunks_exact(k).zip(row) {
-                            let x = &features[b as usize];
-                            for l in 0..LANES {
-                                sum[l] += x[l];
-                            }
-                        }
-                        *acc = sum;
+                        *acc = block_row_sum(&table[block * nf_i * k..][..nf_i * k], row, k);
                     }
                 }
             });
