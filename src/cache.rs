@@ -21,6 +21,14 @@
 //! and checksum all match and the payload decodes to data of the mesh's size; anything else is
 //! recomputed and rewritten. Files are written atomically (temporary file in the same directory,
 //! then rename), so a crash never leaves a half-written entry under a valid name.
+//!
+//! # The compact bands entry
+//! The collection stage needs only each shape's band table and vertex areas (a few MB for 10k
+//! vertices), while the full entry also holds the spectrum and the descriptors (about 40 MB).
+//! [`load_or_compute_bands`] therefore keeps a second file per shape,
+//! `<cache_dir>/<key hex>.coseg-bands`, with the same header (magic `"COSEGBND"`) around the
+//! bincode of [`ShapeBands`]; it is written next to the full entry and rebuilt from it (or from
+//! scratch) whenever it is missing or cannot be trusted.
 
 use crate::bands::{BandError, BandOptions, BandTable, band_table};
 use crate::features::{DescriptorOptions, Descriptors, FeatureError, descriptors};
@@ -35,9 +43,12 @@ use thiserror::Error;
 pub const FORMAT_VERSION: u32 = 2;
 
 const MAGIC: &[u8; 8] = b"COSEGSHP";
+const BANDS_MAGIC: &[u8; 8] = b"COSEGBND";
 const HEADER_LEN: usize = 8 + 4 + 32 + 8 + 32;
 /// File extension of cache entries.
 pub const CACHE_EXTENSION: &str = "coseg-shape";
+/// File extension of the compact bands entries (see [`load_or_compute_bands`]).
+pub const BANDS_EXTENSION: &str = "coseg-bands";
 
 /// Errors of the per-shape pipeline and its cache.
 #[derive(Debug, Error)]
@@ -97,6 +108,41 @@ pub struct ShapeData {
     pub descriptors: Descriptors,
     /// `d × N` band labels.
     pub bands: BandTable,
+}
+
+/// What the collection stage needs of a shape: its band table and vertex areas (the compact
+/// cache entry of [`load_or_compute_bands`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ShapeBands {
+    /// The key these data were computed for (see [`shape_key`]).
+    pub key: ShapeKey,
+    /// `d × N` band labels.
+    pub bands: BandTable,
+    /// Per-vertex areas (length `d`), as [`Descriptors::vertex_areas`].
+    pub vertex_areas: Vec<f64>,
+}
+
+impl ShapeBands {
+    /// The compact part of `data`.
+    pub fn of(data: &ShapeData) -> Self {
+        Self {
+            key: data.key,
+            bands: data.bands.clone(),
+            vertex_areas: data.descriptors.vertex_areas.clone(),
+        }
+    }
+}
+
+/// The result of [`load_or_compute_bands`].
+#[derive(Debug, Clone)]
+pub struct BandsResult {
+    /// The shape's band table and areas (identical whether read or computed).
+    pub data: ShapeBands,
+    /// Hit (the compact entry was valid), or where the data came from otherwise: the full
+    /// entry's outcome ([`CacheOutcome::Hit`] when rebuilt from a valid full entry).
+    pub outcome: CacheOutcome,
+    /// Warnings for the caller: untrusted compact entries, entries that could not be written.
+    pub warnings: Vec<String>,
 }
 
 /// Where [`load_or_compute`]'s data came from.
@@ -284,27 +330,119 @@ pub fn load_or_compute(
     })
 }
 
-/// The bytes of a cache entry for `data` (header + payload, see the module docs).
-pub fn encode_entry(data: &ShapeData) -> Vec<u8> {
+/// The bands entry path of `key` in `cache_dir` (see [`load_or_compute_bands`]).
+pub fn bands_path(cache_dir: &Path, key: &ShapeKey) -> PathBuf {
+    cache_dir.join(format!("{}.{BANDS_EXTENSION}", key.to_hex()))
+}
+
+/// The shape's band table and vertex areas: from the compact bands entry in `cache_dir` if it
+/// is valid, otherwise from [`load_or_compute`] (the full entry, or computed), after which the
+/// compact entry is written. Reading 10k vertices × 300 features this way costs about a tenth
+/// of reading the full entry, which is what makes a warm `coseg segment` fast.
+///
+/// ```
+/// use coseg::cache::{load_or_compute, load_or_compute_bands, CacheOutcome, ShapePipelineOptions};
+/// use coseg::mesh::TriMesh;
+/// let dir = std::env::temp_dir().join(format!("coseg-doc-bands-{}", std::process::id()));
+/// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
+/// let mut o = ShapePipelineOptions::default();
+/// o.spectrum.eigenpairs = 4;
+/// o.bands.bands = 2;
+/// let first = load_or_compute_bands(&m, &o, &dir).unwrap();
+/// assert_eq!(first.outcome, CacheOutcome::Miss);
+/// let second = load_or_compute_bands(&m, &o, &dir).unwrap();
+/// assert_eq!(second.outcome, CacheOutcome::Hit);
+/// assert_eq!(second.data.bands, load_or_compute(&m, &o, &dir).unwrap().data.bands);
+/// # std::fs::remove_dir_all(&dir).ok();
+/// ```
+pub fn load_or_compute_bands(
+    mesh: &TriMesh,
+    options: &ShapePipelineOptions,
+    cache_dir: &Path,
+) -> Result<BandsResult, PipelineError> {
+    let key = shape_key(mesh, options);
+    let path = bands_path(cache_dir, &key);
+    let mut warnings = Vec::new();
+    match std::fs::read(&path) {
+        Ok(bytes) => match decode_bands_entry(&bytes, &key, mesh.vertex_count()) {
+            Ok(data) => {
+                return Ok(BandsResult {
+                    data,
+                    outcome: CacheOutcome::Hit,
+                    warnings,
+                });
+            }
+            Err(reason) => warnings.push(format!("{}: {reason}; rebuilt", path.display())),
+        },
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+        Err(e) => warnings.push(format!("{}: unreadable ({e}); rebuilt", path.display())),
+    }
+    let full = load_or_compute(mesh, options, cache_dir)?;
+    if let CacheOutcome::Recomputed { reason } = &full.outcome {
+        warnings.push(reason.clone());
+    }
+    warnings.extend(full.write_error);
+    let data = ShapeBands::of(&full.data);
+    let entry = encode_bands_entry(&data);
+    if let Err(e) = write_atomic(&path, |w| w.write_all(&entry)) {
+        warnings.push(format!("{}: cache entry not written: {e}", path.display()));
+    }
+    Ok(BandsResult {
+        data,
+        outcome: full.outcome,
+        warnings,
+    })
+}
+
+/// The bytes of a compact bands entry for `data` (see the module docs).
+pub fn encode_bands_entry(data: &ShapeBands) -> Vec<u8> {
     let payload = bincode::serde::encode_to_vec(data, bincode::config::standard())
-        .expect("shape data are plain data and always encode");
+        .expect("band data are plain data and always encode");
+    frame(BANDS_MAGIC, &data.key, payload)
+}
+
+/// Verifies and decodes a compact bands entry; `Err` says why it cannot be trusted.
+fn decode_bands_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeBands, String> {
+    let payload = unframe(bytes, BANDS_MAGIC, key)?;
+    let (data, used): (ShapeBands, usize) =
+        bincode::serde::decode_from_slice(payload, bincode::config::standard())
+            .map_err(|e| format!("payload does not decode ({e})"))?;
+    if used != payload.len() {
+        return Err("payload has trailing bytes".into());
+    }
+    if data.key != *key {
+        return Err("payload key does not match".into());
+    }
+    let t = &data.bands;
+    let consistent = t.vertices == vertices
+        && t.labels.len() == t.features * vertices
+        && t.labels.iter().all(|&l| (l as usize) < t.bands)
+        && data.vertex_areas.len() == vertices;
+    if !consistent {
+        return Err("payload sizes do not match the mesh".into());
+    }
+    Ok(data)
+}
+
+/// `magic | format version | key | payload length | BLAKE3 of payload | payload`.
+fn frame(magic: &[u8; 8], key: &ShapeKey, payload: Vec<u8>) -> Vec<u8> {
     let mut out = Vec::with_capacity(HEADER_LEN + payload.len());
-    out.extend_from_slice(MAGIC);
+    out.extend_from_slice(magic);
     out.extend_from_slice(&FORMAT_VERSION.to_le_bytes());
-    out.extend_from_slice(&data.key.0);
+    out.extend_from_slice(&key.0);
     out.extend_from_slice(&(payload.len() as u64).to_le_bytes());
     out.extend_from_slice(blake3::hash(&payload).as_bytes());
     out.extend_from_slice(&payload);
     out
 }
 
-/// Verifies and decodes a cache entry; `Err` says why it cannot be trusted.
-fn decode_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeData, String> {
+/// The verified payload of a framed entry; `Err` says why it cannot be trusted.
+fn unframe<'b>(bytes: &'b [u8], magic: &[u8; 8], key: &ShapeKey) -> Result<&'b [u8], String> {
     if bytes.len() < HEADER_LEN {
         return Err(format!("truncated header ({} bytes)", bytes.len()));
     }
-    if &bytes[..8] != MAGIC {
-        return Err("not a coseg cache file (bad magic)".into());
+    if &bytes[..8] != magic {
+        return Err("not a coseg cache file of this kind (bad magic)".into());
     }
     let version = u32::from_le_bytes(bytes[8..12].try_into().expect("4 bytes"));
     if version != FORMAT_VERSION {
@@ -326,6 +464,19 @@ fn decode_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeDa
     if blake3::hash(payload).as_bytes() != &bytes[52..84] {
         return Err("payload checksum mismatch (corrupt)".into());
     }
+    Ok(payload)
+}
+
+/// The bytes of a cache entry for `data` (header + payload, see the module docs).
+pub fn encode_entry(data: &ShapeData) -> Vec<u8> {
+    let payload = bincode::serde::encode_to_vec(data, bincode::config::standard())
+        .expect("shape data are plain data and always encode");
+    frame(MAGIC, &data.key, payload)
+}
+
+/// Verifies and decodes a cache entry; `Err` says why it cannot be trusted.
+fn decode_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeData, String> {
+    let payload = unframe(bytes, MAGIC, key)?;
     let (data, used): (ShapeData, usize) =
         bincode::serde::decode_from_slice(payload, bincode::config::standard())
             .map_err(|e| format!("payload does not decode ({e})"))?;

@@ -177,3 +177,74 @@ fn a_file_in_place_of_the_directory_is_an_error_not_a_panic() {
     std::fs::write(&file, b"x").unwrap();
     assert!(load_or_compute(&mesh(), &opts(), &file).is_err());
 }
+
+// The compact bands entry
+
+/// The bands entry is written on the first call (with the full entry), read on the next, and
+/// holds exactly the full entry's band table and vertex areas.
+#[test]
+fn bands_entry_miss_then_hit_matches_the_full_entry() {
+    use coseg::cache::{ShapeBands, bands_path, load_or_compute_bands};
+    let dir = tempfile::tempdir().unwrap();
+    let (m, o) = (mesh(), opts());
+    let first = load_or_compute_bands(&m, &o, dir.path()).unwrap();
+    assert_eq!(first.outcome, CacheOutcome::Miss);
+    assert!(first.warnings.is_empty(), "{:?}", first.warnings);
+    let key = shape_key(&m, &o);
+    assert!(bands_path(dir.path(), &key).exists());
+    assert!(cache_path(dir.path(), &key).exists());
+    let second = load_or_compute_bands(&m, &o, dir.path()).unwrap();
+    assert_eq!(second.outcome, CacheOutcome::Hit);
+    let full = load_or_compute(&m, &o, dir.path()).unwrap();
+    assert_eq!(second.data, ShapeBands::of(&full.data));
+    assert_eq!(first.data, second.data);
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 2);
+}
+
+/// A corrupt, truncated or foreign bands entry is never trusted: it is rebuilt from the full
+/// entry (no recomputation), with a warning naming the file and the reason; a missing one is
+/// rebuilt silently.
+#[test]
+fn bad_bands_entries_are_rebuilt_from_the_full_entry() {
+    use coseg::cache::{bands_path, load_or_compute_bands};
+    let dir = tempfile::tempdir().unwrap();
+    let (m, o) = (mesh(), opts());
+    let good = load_or_compute_bands(&m, &o, dir.path()).unwrap().data;
+    let path = bands_path(dir.path(), &shape_key(&m, &o));
+    let bytes = std::fs::read(&path).unwrap();
+    let mut flipped = bytes.clone();
+    let mid = flipped.len() / 2;
+    flipped[mid] ^= 0x40;
+    let full = std::fs::read(cache_path(dir.path(), &shape_key(&m, &o))).unwrap();
+    for (bad, needle) in [
+        (flipped, "checksum"),
+        (bytes[..bytes.len() - 3].to_vec(), "payload is"),
+        (bytes[..10].to_vec(), "truncated header"),
+        (full, "bad magic"),
+    ] {
+        std::fs::write(&path, &bad).unwrap();
+        let r = load_or_compute_bands(&m, &o, dir.path()).unwrap();
+        assert_eq!(
+            r.outcome,
+            CacheOutcome::Hit,
+            "{needle}: the full entry was valid"
+        );
+        assert_eq!(r.data, good);
+        assert!(
+            r.warnings
+                .iter()
+                .any(|w| w.contains(needle) && w.contains("coseg-bands")),
+            "{needle}: {:?}",
+            r.warnings
+        );
+        assert_eq!(
+            std::fs::read(&path).unwrap(),
+            bytes,
+            "{needle}: entry rewritten"
+        );
+    }
+    std::fs::remove_file(&path).unwrap();
+    let r = load_or_compute_bands(&m, &o, dir.path()).unwrap();
+    assert_eq!((r.outcome, r.warnings.len()), (CacheOutcome::Hit, 0));
+    assert_eq!(std::fs::read(&path).unwrap(), bytes);
+}

@@ -616,19 +616,36 @@ pub fn cosegment(
         let mut seen = vec![tuple_hash(&tuple)];
         let mut best: Option<(f64, Vec<Vec<u32>>)> = None;
         let (mut sweeps, mut converged, mut cycled, mut objective) = (0, false, false, 0.0);
+        // A shape whose neighbours' regions have not changed since its last update would get
+        // the same scores and the same region again: skip it, reusing its objective term.
+        // `changed_at[j]` / `updated_at[i]` are ticks of one clock that advances on every
+        // update, so the skip is exact and the result identical to recomputing everything.
+        let mut clock = 1usize;
+        let mut changed_at = vec![clock; n];
+        let mut updated_at = vec![0usize; n];
+        let mut term = vec![0.0; n];
         while sweeps < options.max_sweeps {
             sweeps += 1;
             let mut changed = false;
             objective = 0.0;
             for &i in &order {
-                eng.scores(i, None, &rem[i], &mut scores);
-                eng.select(i, &rem[i], &scores, alpha, &mut f);
-                objective += super::stable_cycle::selected_sum(&rem[i], &scores, &f);
-                if f != tuple[i] {
-                    changed = true;
-                    tuple[i].clone_from(&f);
-                    eng.set_region(i, &f);
+                let stale = eng.neighbours[i]
+                    .iter()
+                    .any(|nb| changed_at[nb.j] >= updated_at[i]);
+                if stale {
+                    clock += 1;
+                    updated_at[i] = clock;
+                    eng.scores(i, None, &rem[i], &mut scores);
+                    eng.select(i, &rem[i], &scores, alpha, &mut f);
+                    term[i] = super::stable_cycle::selected_sum(&rem[i], &scores, &f);
+                    if f != tuple[i] {
+                        changed = true;
+                        changed_at[i] = clock;
+                        tuple[i].clone_from(&f);
+                        eng.set_region(i, &f);
+                    }
                 }
+                objective += term[i];
             }
             if !changed {
                 converged = true;

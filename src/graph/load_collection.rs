@@ -1,7 +1,7 @@
 //! [`load_collection`]: a folder of meshes to shape-graph nodes through the per-shape cache.
 
 use super::{GraphError, ShapeNode};
-use crate::cache::{CacheOutcome, ShapePipelineOptions, load_or_compute};
+use crate::cache::{CacheOutcome, ShapePipelineOptions, load_or_compute_bands};
 use crate::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
@@ -58,7 +58,8 @@ pub fn mesh_files(folder: &Path) -> Result<Vec<PathBuf>, GraphError> {
 }
 
 /// Reads every mesh file of `folder` ([`mesh_files`]) and gets its band table through the
-/// per-shape cache in `cache_dir` ([`crate::cache::load_or_compute`]). Shapes are processed in
+/// per-shape cache in `cache_dir` ([`crate::cache::load_or_compute_bands`]: only the band
+/// tables and vertex areas are read when the cache is warm). Shapes are processed in
 /// parallel on rayon's pool (one shape per thread: the per-shape work is independent, so the
 /// result is the same whatever the thread count); the result keeps file order. Files that fail
 /// to read or compute are reported in [`LoadedCollection::skipped`], not fatal.
@@ -166,7 +167,7 @@ fn load_one(
         r.warnings.push(format!("{}: {w}", path.display()));
     }
     let t = Instant::now();
-    let data = load_or_compute(&mesh, options, cache_dir);
+    let data = load_or_compute_bands(&mesh, options, cache_dir);
     r.shape_time = t.elapsed();
     let res = match data {
         Ok(x) => x,
@@ -175,17 +176,12 @@ fn load_one(
             return r;
         }
     };
-    if let CacheOutcome::Recomputed { reason } = &res.outcome {
-        r.warnings.push(reason.clone());
-    }
-    if let Some(w) = &res.write_error {
-        r.warnings.push(w.clone());
-    }
+    r.warnings.extend(res.warnings);
     let name = path
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| format!("shape{i}"));
-    r.outcome = match ShapeNode::new(name, res.data.bands, &res.data.descriptors.vertex_areas) {
+    r.outcome = match ShapeNode::new(name, res.data.bands, &res.data.vertex_areas) {
         Ok(node) => Ok((mesh, node, res.outcome)),
         Err(e) => skip(format!("{}: {e}", path.display())),
     };
