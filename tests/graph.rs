@@ -464,6 +464,20 @@ fn graph_rejects_incompatible_shapes() {
     assert!(ShapeGraph::build(nodes, &GraphOptions::default()).is_err());
     assert!(ShapeNode::new("c", random_table(20, 8, 4, 3), &[1.0; 19]).is_err());
     assert!(ShapeNode::new("d", random_table(20, 8, 4, 3), &[0.0; 20]).is_err());
+    // A label out of range, or a table of the wrong size, is an error naming the shape, not a
+    // panic in a later gather.
+    let mut bad = random_table(20, 8, 4, 4);
+    bad.labels[37] = 4;
+    let mut short = random_table(20, 8, 4, 5);
+    short.labels.pop();
+    for (name, t) in [("bad", bad), ("short", short)] {
+        let nodes = vec![
+            ShapeNode::new("ok", random_table(20, 8, 4, 6), &[1.0; 20]).unwrap(),
+            ShapeNode::new(name, t, &[1.0; 20]).unwrap(),
+        ];
+        let err = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap_err();
+        assert!(err.to_string().contains(name), "{err}");
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

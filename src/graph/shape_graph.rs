@@ -224,6 +224,20 @@ impl ShapeGraph {
                         reason: "area vector does not match the vertex count".into(),
                     });
                 }
+                // Every stage indexes per-band tables by these labels; the graph owns its nodes
+                // immutably, so one check here covers them all.
+                let t = &node.bands;
+                if t.labels.len() != t.vertices * t.features
+                    || t.labels.iter().any(|&l| l as usize >= t.bands)
+                {
+                    return Err(GraphError::Incompatible {
+                        name: node.name.clone(),
+                        reason: format!(
+                            "band table is not {} × {} labels below K = {}",
+                            t.vertices, t.features, t.bands
+                        ),
+                    });
+                }
             }
         }
         let n = nodes.len();

@@ -4,6 +4,7 @@ use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::Llt;
 use faer::sparse::{SparseColMat, Triplet};
 use faer::{MatMut, Side};
+use rayon::prelude::*;
 
 /// One backward-Euler step of the heat equation on a mesh scaled to unit total area:
 /// `u = (M + t L)⁻¹ M x`, with `L` the cotangent Laplacian and `M` the lumped mass of the
@@ -102,8 +103,13 @@ impl HeatSmoother {
                 *v *= m;
             }
         }
-        let rhs = MatMut::from_column_major_slice_mut(x, d, columns);
-        self.llt.solve_in_place(rhs);
+        // Columns are independent: solve them in groups on rayon's threads (the result does not
+        // depend on the grouping).
+        let per_task = columns.div_ceil(rayon::current_num_threads()).max(1);
+        x.par_chunks_mut(d * per_task).for_each(|group| {
+            let rhs = MatMut::from_column_major_slice_mut(group, d, group.len() / d);
+            self.llt.solve_in_place(rhs);
+        });
         Ok(())
     }
 }
