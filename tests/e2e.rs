@@ -231,12 +231,8 @@ fn segment_regions_agree_with_ground_truth_parts() {
     assert!(coverage >= SEGMENT_COVERAGE_FLOOR, "coverage {coverage:.3}");
 }
 
-#[test]
-fn segment_is_deterministic() {
-    // A second run from scratch (its own cache, so every spectrum is recomputed).
-    let (first, second) = (segment_run(), segment("segment_again"));
-    assert_success(first);
-    assert_success(&second);
+/// Every output file of two runs (not the cache) is byte-identical; returns how many there are.
+fn assert_same_files(first: &Path, second: &Path) -> usize {
     let files = |dir: &Path| {
         let mut names: Vec<String> = std::fs::read_dir(dir)
             .unwrap()
@@ -246,18 +242,41 @@ fn segment_is_deterministic() {
         names.sort();
         names
     };
-    let names = files(&first.out);
-    assert_eq!(names, files(&second.out));
-    // Six shapes × (regions.txt, regions.ply) + summary.json (which holds no timings or
-    // output paths, so it is byte-identical too).
-    assert_eq!(names.len(), 13);
+    let names = files(first);
+    assert_eq!(names, files(second));
     for name in &names {
         let (a, b) = (
-            std::fs::read(first.out.join(name)).unwrap(),
-            std::fs::read(second.out.join(name)).unwrap(),
+            std::fs::read(first.join(name)).unwrap(),
+            std::fs::read(second.join(name)).unwrap(),
         );
         assert!(a == b, "{name} differs between two runs");
     }
+    names.len()
+}
+
+#[test]
+fn segment_is_deterministic() {
+    // A second run from scratch (its own cache, so every spectrum is recomputed).
+    let (first, second) = (segment_run(), segment("segment_again"));
+    assert_success(first);
+    assert_success(&second);
+    // Six shapes × (regions.txt, regions.ply) + summary.json (which holds no timings or
+    // output paths, so it is byte-identical too).
+    assert_eq!(assert_same_files(&first.out, &second.out), 13);
+}
+
+#[test]
+fn pair_is_deterministic() {
+    let first = pair_run();
+    let out = scratch("pair_again");
+    let (a, b) = (
+        quadrupeds().join(format!("{PAIR_A}.obj")),
+        quadrupeds().join(format!("{PAIR_B}.obj")),
+    );
+    let second = coseg(&["pair".as_ref(), &a, &b, "-o".as_ref(), &out]);
+    assert_success(first);
+    assert!(second.status.success());
+    assert_eq!(assert_same_files(&first.out, &out), 5);
 }
 
 #[test]

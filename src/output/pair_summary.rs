@@ -53,7 +53,10 @@ pub struct PairSummary {
     pub regions: Vec<RegionSummary>,
     /// Correspondence ratio against the given ground truth, if any (fraction in `[0, 1]`).
     pub correspondence_ratio: Option<f64>,
-    /// Seconds spent in the stable-region algorithm (excluding per-shape data).
+    /// Seconds spent in the stable-region algorithm (excluding per-shape data). Not written
+    /// to `summary.json`, so that the same inputs give the same file byte for byte (the CLI
+    /// prints it instead).
+    #[serde(skip)]
     pub seconds: f64,
 }
 
