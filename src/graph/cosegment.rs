@@ -183,6 +183,8 @@ pub(super) struct Engine<'g> {
     hist: Vec<Vec<f64>>,
     /// Size of the current region of each shape.
     size: Vec<usize>,
+    /// The current region of each shape (ascending).
+    current: Vec<Vec<u32>>,
     /// The mixed per-(feature, band) scores of the shape being updated, in `f32`: the gather
     /// reads one entry per (vertex, feature), and the smaller table stays in L1.
     table: Vec<f32>,
@@ -244,21 +246,50 @@ impl<'g> Engine<'g> {
             neighbours,
             hist,
             size: vec![0; n],
+            current: vec![Vec::new(); n],
             table: Vec::new(),
             scratch: Default::default(),
         }
     }
 
+    /// Makes `region` (strictly ascending) shape `i`'s current region. The histogram is
+    /// updated by the vertices that enter or leave (counts are exact integers, so this equals a
+    /// rebuild), which in late sweeps are a few boundary vertices.
     pub(super) fn set_region(&mut self, i: usize, region: &[u32]) {
         let t = &self.graph.node(i).bands;
         let k = self.bands;
         let h = &mut self.hist[i];
-        h.fill(0.0);
-        for &p in region {
+        let mut add = |p: u32, delta: f64| {
             for (f, &l) in t.row(p as usize).iter().enumerate() {
-                h[f * k + l as usize] += 1.0;
+                h[f * k + l as usize] += delta;
+            }
+        };
+        let old = &self.current[i];
+        debug_assert!(old.is_empty() || region.windows(2).all(|w| w[0] < w[1]));
+        let (mut a, mut b) = (0, 0);
+        while a < old.len() || b < region.len() {
+            match (old.get(a), region.get(b)) {
+                (Some(&x), Some(&y)) if x == y => {
+                    a += 1;
+                    b += 1;
+                }
+                (Some(&x), Some(&y)) if x < y => {
+                    add(x, -1.0);
+                    a += 1;
+                }
+                (Some(&x), None) => {
+                    add(x, -1.0);
+                    a += 1;
+                }
+                (_, Some(&y)) => {
+                    add(y, 1.0);
+                    b += 1;
+                }
+                (None, None) => unreachable!("loop condition"),
             }
         }
+        self.current[i].clear();
+        self.current[i].extend_from_slice(region);
         self.size[i] = region.len();
     }
 
@@ -271,6 +302,13 @@ impl<'g> Engine<'g> {
         rem: &[u32],
         out: &mut Vec<f64>,
     ) {
+        self.mix(i, sources);
+        self.gather(i, rem, out);
+    }
+
+    /// Builds `table` for shape `i`: the per-(feature, band) score contributions of the current
+    /// regions of `sources` (all neighbours when `None`).
+    fn mix(&mut self, i: usize, sources: Option<&[usize]>) {
         let t = &self.graph.node(i).bands;
         let k = self.bands;
         self.table.clear();
@@ -291,16 +329,32 @@ impl<'g> Engine<'g> {
                 }
             }
         }
+    }
+
+    /// Scores of the vertices `list` of shape `i` from the current `table`.
+    fn gather(&self, i: usize, list: &[u32], out: &mut Vec<f64>) {
+        let t = &self.graph.node(i).bands;
+        let k = self.bands;
         out.clear();
-        out.resize(rem.len(), 0.0);
+        out.resize(list.len(), 0.0);
         let table = &self.table;
         out.par_chunks_mut(512)
-            .zip(rem.par_chunks(512))
+            .zip(list.par_chunks(512))
             .for_each(|(o, idx)| {
                 for (s, &q) in o.iter_mut().zip(idx) {
                     *s = row_sum(table, t.row(q as usize), k);
                 }
             });
+    }
+
+    /// `Σ_{q ∈ f_i} score_i(q)` for shape `i`'s current region, from `table` and the region's
+    /// histogram (scores are linear in the table): `Σ_{f, b} table[f, b] · hist_i[f, b]`.
+    fn region_objective(&self, i: usize) -> f64 {
+        self.table
+            .iter()
+            .zip(&self.hist[i])
+            .map(|(&t, &h)| f64::from(t) * h)
+            .sum()
     }
 
     /// `P_α(scores)` on `rem` of shape `i`.
@@ -314,6 +368,142 @@ impl<'g> Engine<'g> {
             out,
             &mut self.scratch,
         );
+    }
+}
+
+/// Exact pruning of the gather in late sweeps.
+///
+/// For each shape, a reference: the mixed table `T_ref`, the scores `s_ref` of every remaining
+/// vertex under it, and the score `θ_ref` of the last vertex `P_α` selected. Scores are linear
+/// in the table, so under the current table `T` every score is within
+/// `B = Σ_f max_b |T[f, b] − T_ref[f, b]|` of its reference, and the new cut-off score of `P_α`
+/// is within `B` of `θ_ref` (the sets above any level move by at most `B`). Hence a vertex with
+/// `s_ref > θ_ref + 2B` is selected and one with `s_ref < θ_ref − 2B` is not, whatever their
+/// exact new scores; only the vertices in between need a gather. `P_α` on those candidates
+/// (with the sure ones ranked first) selects the same vertices as on all of them, since sure
+/// vertices lie strictly above the new cut-off and ties at the cut-off are all candidates.
+/// When the candidates are more than half of the remaining vertices, a full gather is cheaper:
+/// it runs and becomes the new reference. A margin covers the `f32` rounding of the gather.
+struct Pruning {
+    refs: Vec<Option<Reference>>,
+    list: Vec<u32>,
+    keys: Vec<f64>,
+    candidates: Vec<u32>,
+    exact: Vec<f64>,
+}
+
+struct Reference {
+    table: Vec<f32>,
+    scores: Vec<f64>,
+    cutoff: f64,
+}
+
+impl Pruning {
+    fn new(n: usize) -> Self {
+        Self {
+            refs: (0..n).map(|_| None).collect(),
+            list: Vec::new(),
+            keys: Vec::new(),
+            candidates: Vec::new(),
+            exact: Vec::new(),
+        }
+    }
+
+    /// Makes the engine's current table and the full `scores` on `rem` shape `i`'s reference,
+    /// `selected` being `P_α` of them.
+    fn reset(
+        &mut self,
+        eng: &Engine<'_>,
+        i: usize,
+        rem: &[u32],
+        scores: &[f64],
+        selected: &[u32],
+        alpha: f64,
+    ) {
+        let areas = &eng.graph.node(i).areas;
+        let area: f64 = selected.iter().map(|&v| areas[v as usize]).sum();
+        // Without a cut-off (everything selected, or nothing), there is nothing to prune by.
+        if selected.is_empty() || selected.len() == rem.len() || area < alpha {
+            self.refs[i] = None;
+            return;
+        }
+        let mut cutoff = f64::INFINITY;
+        let mut j = 0;
+        for (&v, &s) in rem.iter().zip(scores) {
+            if j < selected.len() && selected[j] == v {
+                cutoff = cutoff.min(s);
+                j += 1;
+            }
+        }
+        self.refs[i] = Some(Reference {
+            table: eng.table.clone(),
+            scores: scores.to_vec(),
+            cutoff,
+        });
+    }
+
+    /// `P_α` on `rem` of shape `i` under the engine's current table, into `out`, by the pruned
+    /// gather; `false` (and `out` unspecified) when it does not apply and a full gather is due.
+    fn select(
+        &mut self,
+        eng: &mut Engine<'_>,
+        i: usize,
+        rem: &[u32],
+        alpha: f64,
+        out: &mut Vec<u32>,
+    ) -> bool {
+        let Some(r) = &self.refs[i] else {
+            return false;
+        };
+        let k = eng.bands;
+        let bound: f64 = eng
+            .table
+            .chunks_exact(k)
+            .zip(r.table.chunks_exact(k))
+            .map(|(a, b)| {
+                a.iter()
+                    .zip(b)
+                    .map(|(&x, &y)| (f64::from(x) - f64::from(y)).abs())
+                    .fold(0.0, f64::max)
+            })
+            .sum();
+        // Gathered scores are sums of ~N non-negative f32 terms: their rounding error is below
+        // N · 2⁻²⁴ · score, far inside the relative 1e-3 added here.
+        let margin = 2.0 * bound + 1e-3 * (r.cutoff.abs() + bound) + 1e-9;
+        let (hi, lo) = (r.cutoff + margin, r.cutoff - margin);
+        self.list.clear();
+        self.keys.clear();
+        self.candidates.clear();
+        for (&v, &s) in rem.iter().zip(&r.scores) {
+            if s >= lo && s <= hi {
+                self.candidates.push(v);
+            }
+        }
+        if 2 * self.candidates.len() > rem.len() {
+            return false;
+        }
+        let mut exact = std::mem::take(&mut self.exact);
+        eng.gather(i, &self.candidates, &mut exact);
+        let r = self.refs[i].as_ref().expect("checked above");
+        let mut c = 0;
+        for (&v, &s) in rem.iter().zip(&r.scores) {
+            if s > hi {
+                self.list.push(v);
+                self.keys.push(f64::INFINITY);
+            } else if s >= lo {
+                debug_assert_eq!(self.candidates[c], v);
+                self.list.push(v);
+                self.keys.push(exact[c]);
+                c += 1;
+            }
+        }
+        self.exact = exact;
+        eng.select(i, &self.list, &self.keys, alpha, out);
+        // Safety net: if the sure and candidate vertices do not reach the area, the bound did
+        // not hold (it cannot, up to rounding); let the full gather decide.
+        let areas = &eng.graph.node(i).areas;
+        let area: f64 = out.iter().map(|&v| areas[v as usize]).sum();
+        area >= alpha && out.len() < self.list.len()
     }
 }
 
@@ -624,6 +814,7 @@ pub fn cosegment(
         let mut changed_at = vec![clock; n];
         let mut updated_at = vec![0usize; n];
         let mut term = vec![0.0; n];
+        let mut prune = Pruning::new(n);
         while sweeps < options.max_sweeps {
             sweeps += 1;
             let mut changed = false;
@@ -635,15 +826,19 @@ pub fn cosegment(
                 if stale {
                     clock += 1;
                     updated_at[i] = clock;
-                    eng.scores(i, None, &rem[i], &mut scores);
-                    eng.select(i, &rem[i], &scores, alpha, &mut f);
-                    term[i] = super::stable_cycle::selected_sum(&rem[i], &scores, &f);
+                    eng.mix(i, None);
+                    if !prune.select(&mut eng, i, &rem[i], alpha, &mut f) {
+                        eng.gather(i, &rem[i], &mut scores);
+                        eng.select(i, &rem[i], &scores, alpha, &mut f);
+                        prune.reset(&eng, i, &rem[i], &scores, &f, alpha);
+                    }
                     if f != tuple[i] {
                         changed = true;
                         changed_at[i] = clock;
                         tuple[i].clone_from(&f);
                         eng.set_region(i, &f);
                     }
+                    term[i] = eng.region_objective(i);
                 }
                 objective += term[i];
             }
