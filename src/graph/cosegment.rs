@@ -22,9 +22,11 @@
 //!   i.e. the consistency that cycles sharing shapes must agree on is imposed directly.
 //! - A fixed point is consistent everywhere at once; there is no choice of cycle basis and no
 //!   reconciliation step where cycles overlap.
-//! - One sweep costs one histogram scatter per changed region (`O(N |f_j|)`), one `N × K`
-//!   mix per edge, and one gather over each shape's remaining vertices (`O(N d_i)`): it scales
-//!   with the number of shapes, not with the number of cycles.
+//! - One sweep costs a histogram update per changed region (`O(N)` per vertex entering or
+//!   leaving it), one `N × K` mix per edge, and one gather over each shape's remaining vertices
+//!   (`O(N d_i)`; in late sweeps only over the vertices whose score could cross the area
+//!   cut-off, an exact pruning): it scales with the number of shapes, not with the number of
+//!   cycles. Shapes whose neighbours did not change since their last update are skipped.
 //! - The stop test is exact: when a sweep changes nothing, every `f_i` was recomputed from the
 //!   final neighbours, so the tuple satisfies the equations above simultaneously
 //!   ([`cosegment_update`] checks it). A guard as in Algorithm 1: a sweep cap and cycle

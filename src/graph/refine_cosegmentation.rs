@@ -144,9 +144,9 @@ pub fn refine_cosegmentation(
 }
 
 /// Regions are processed in blocks of this many lanes, each block an `[f32; LANES]` that the
-/// gather keeps in one vector register. The tables are `f32`: the gather reads one block per
-/// (vertex, feature) and is bound by cache bandwidth, and single precision halves it; scores
-/// are sums of 300-odd non-negative terms of similar size, far from `f32`'s limits.
+/// gather keeps in one vector register. The tables are `f32`, half the memory the gather reads
+/// per (vertex, feature); scores are sums of 300-odd non-negative terms of similar size, far
+/// from `f32`'s limits (the result matched the `f64` version on TOSCA cats and FAUST).
 const LANES: usize = 8;
 
 /// `LANES` regions' values for one (feature, band).
