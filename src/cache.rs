@@ -294,23 +294,18 @@ pub fn load_or_compute(
 ) -> Result<CacheResult, PipelineError> {
     let key = shape_key(mesh, options);
     let path = cache_path(cache_dir, &key);
-    let outcome = match std::fs::read(&path) {
-        Ok(bytes) => match decode_entry(&bytes, &key, mesh.vertex_count()) {
-            Ok(data) => {
-                return Ok(CacheResult {
-                    data,
-                    outcome: CacheOutcome::Hit,
-                    path,
-                    write_error: None,
-                });
-            }
-            Err(reason) => CacheOutcome::Recomputed {
-                reason: format!("{}: {reason}; recomputed", path.display()),
-            },
-        },
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => CacheOutcome::Miss,
-        Err(e) => CacheOutcome::Recomputed {
-            reason: format!("{}: unreadable ({e}); recomputed", path.display()),
+    let outcome = match read_entry(&path, |b| decode_entry(b, &key, mesh.vertex_count())) {
+        Ok(data) => {
+            return Ok(CacheResult {
+                data,
+                outcome: CacheOutcome::Hit,
+                path,
+                write_error: None,
+            });
+        }
+        Err(None) => CacheOutcome::Miss,
+        Err(Some(reason)) => CacheOutcome::Recomputed {
+            reason: format!("{}: {reason}; recomputed", path.display()),
         },
     };
     let data = compute_shape_data(mesh, options)?;
@@ -363,19 +358,16 @@ pub fn load_or_compute_bands(
     let key = shape_key(mesh, options);
     let path = bands_path(cache_dir, &key);
     let mut warnings = Vec::new();
-    match std::fs::read(&path) {
-        Ok(bytes) => match decode_bands_entry(&bytes, &key, mesh.vertex_count()) {
-            Ok(data) => {
-                return Ok(BandsResult {
-                    data,
-                    outcome: CacheOutcome::Hit,
-                    warnings,
-                });
-            }
-            Err(reason) => warnings.push(format!("{}: {reason}; rebuilt", path.display())),
-        },
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
-        Err(e) => warnings.push(format!("{}: unreadable ({e}); rebuilt", path.display())),
+    match read_entry(&path, |b| decode_bands_entry(b, &key, mesh.vertex_count())) {
+        Ok(data) => {
+            return Ok(BandsResult {
+                data,
+                outcome: CacheOutcome::Hit,
+                warnings,
+            });
+        }
+        Err(None) => {}
+        Err(Some(reason)) => warnings.push(format!("{}: {reason}; rebuilt", path.display())),
     }
     let full = load_or_compute(mesh, options, cache_dir)?;
     if let CacheOutcome::Recomputed { reason } = &full.outcome {
@@ -392,6 +384,19 @@ pub fn load_or_compute_bands(
         outcome: full.outcome,
         warnings,
     })
+}
+
+/// Reads and decodes the entry at `path`: the data, `Err(None)` when there is no file, or
+/// `Err(Some(reason))` when the file cannot be read or trusted.
+fn read_entry<T>(
+    path: &Path,
+    decode: impl FnOnce(&[u8]) -> Result<T, String>,
+) -> Result<T, Option<String>> {
+    match std::fs::read(path) {
+        Ok(bytes) => decode(&bytes).map_err(Some),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Err(None),
+        Err(e) => Err(Some(format!("unreadable ({e})"))),
+    }
 }
 
 /// The bytes of a compact bands entry for `data` (see the module docs).
