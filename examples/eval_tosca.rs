@@ -16,14 +16,25 @@ use coseg::cache::{ShapePipelineOptions, load_or_compute};
 use coseg::mesh::read_mesh;
 use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, RefineOptions, StableRegionsOptions, TSearch, VertexMap,
-    correspondence_stats, refine_regions, stable_regions,
+    Algorithm, AreaReference, Init, MapGuidedOptions, RefineOptions, ShapeGeometry,
+    StableRegionsOptions, TSearch, VertexMap, correspondence_stats, map_guided_refinement,
+    refine_regions, stable_regions,
 };
 use std::path::PathBuf;
 use std::time::Instant;
 
-/// `(name, options, refine)`: `refine` runs [`refine_regions`] (default options) on the result.
-fn configs() -> Vec<(&'static str, StableRegionsOptions, bool)> {
+/// What runs after the algorithm.
+#[derive(Clone, Copy, PartialEq)]
+enum Post {
+    None,
+    /// [`refine_regions`] with default options.
+    Refine,
+    /// [`refine_regions`], then [`map_guided_refinement`], default options.
+    RefineMap,
+}
+
+/// `(name, options, post-processing)`.
+fn configs() -> Vec<(&'static str, StableRegionsOptions, Post)> {
     // Explicit inits: the configurations do not depend on the library's default.
     let base = StableRegionsOptions {
         init: Init::Extreme,
@@ -34,14 +45,14 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, bool)> {
         ..base.clone()
     };
     vec![
-        ("alg2-extreme", base.clone(), false),
+        ("alg2-extreme", base.clone(), Post::None),
         (
             "alg2-random",
             StableRegionsOptions {
                 init: Init::Random,
                 ..base.clone()
             },
-            false,
+            Post::None,
         ),
         (
             "alg2-extreme-remaining",
@@ -49,16 +60,16 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, bool)> {
                 area_reference: AreaReference::Remaining,
                 ..base.clone()
             },
-            false,
+            Post::None,
         ),
-        ("alg3-extreme", auto.clone(), false),
+        ("alg3-extreme", auto.clone(), Post::None),
         (
             "alg3-random",
             StableRegionsOptions {
                 init: Init::Random,
                 ..auto.clone()
             },
-            false,
+            Post::None,
         ),
         (
             "alg3-extreme-linear",
@@ -66,7 +77,7 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, bool)> {
                 t_search: TSearch::Linear,
                 ..auto.clone()
             },
-            false,
+            Post::None,
         ),
         (
             "alg3-random-linear-cold",
@@ -76,7 +87,7 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, bool)> {
                 warm_start: false,
                 ..auto.clone()
             },
-            false,
+            Post::None,
         ),
         (
             "alg2-random-refined",
@@ -84,7 +95,7 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, bool)> {
                 init: Init::Random,
                 ..base.clone()
             },
-            true,
+            Post::Refine,
         ),
         (
             "alg3-random-refined",
@@ -92,7 +103,23 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, bool)> {
                 init: Init::Random,
                 ..auto.clone()
             },
-            true,
+            Post::Refine,
+        ),
+        (
+            "alg2-random-mapped",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..base.clone()
+            },
+            Post::RefineMap,
+        ),
+        (
+            "alg3-random-mapped",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..auto.clone()
+            },
+            Post::RefineMap,
         ),
     ]
 }
@@ -198,16 +225,18 @@ fn main() -> anyhow::Result<()> {
                 mesh.vertex_areas(),
                 d.data.bands,
                 smoother,
+                d.data.spectrum,
+                mesh.positions().to_vec(),
             ));
         }
         for a in 0..data.len() {
             for b in a + 1..data.len() {
                 let mut line = format!("{:>8} x {:<8}", data[a].0, data[b].0);
-                for (k, (_, opts, refine)) in configs.iter().enumerate() {
+                for (k, (_, opts, post)) in configs.iter().enumerate() {
                     let t = Instant::now();
                     let mut r =
                         stable_regions(&data[a].2, &data[b].2, &data[a].1, &data[b].1, opts)?;
-                    if *refine {
+                    if *post != Post::None {
                         let w = BandAffinity::new(&data[a].2, &data[b].2)?;
                         r = refine_regions(
                             &w,
@@ -217,6 +246,23 @@ fn main() -> anyhow::Result<()> {
                             Some(&data[a].3),
                             Some(&data[b].3),
                             &RefineOptions::default(),
+                        )?;
+                    }
+                    if *post == Post::RefineMap {
+                        let w = BandAffinity::new(&data[a].2, &data[b].2)?;
+                        r = map_guided_refinement(
+                            &w,
+                            &r,
+                            ShapeGeometry {
+                                spectrum: &data[a].4,
+                                positions: &data[a].5,
+                            },
+                            ShapeGeometry {
+                                spectrum: &data[b].4,
+                                positions: &data[b].5,
+                            },
+                            Some(&data[b].3),
+                            &MapGuidedOptions::default(),
                         )?;
                     }
                     times[k] += t.elapsed().as_secs_f64();

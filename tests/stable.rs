@@ -791,3 +791,257 @@ fn refine_regions_rebuilds_pairs_with_dense_objectives() {
         .is_err()
     );
 }
+
+mod map_guided {
+    use super::common::features::{blob, permutation, permute_mesh};
+    use coseg::affinity::{BandAffinity, Direction};
+    use coseg::cache::{ShapeData, ShapePipelineOptions, compute_shape_data};
+    use coseg::mesh::TriMesh;
+    use coseg::stable::{
+        MapGuidedOptions, MapShape, PointMapOptions, RegionPair, ShapeGeometry, StableRegions,
+        assign_regions, map_guided_refinement, region_point_map, region_scores,
+    };
+
+    fn small_pipeline() -> ShapePipelineOptions {
+        let mut p = ShapePipelineOptions::default();
+        p.spectrum.eigenpairs = 40;
+        p.descriptors.hks_count = 10;
+        p.descriptors.wks_count = 10;
+        p.descriptors.curvature_count = 10;
+        p.bands.bands = 8;
+        p
+    }
+
+    fn options() -> PointMapOptions {
+        PointMapOptions {
+            initial_size: 6,
+            final_size: 40,
+            step: 5,
+            samples: 300,
+            ..Default::default()
+        }
+    }
+
+    /// Six compact patches: the sign of the dominant coordinate of each vertex.
+    fn patches(mesh: &TriMesh) -> Vec<i32> {
+        mesh.positions()
+            .iter()
+            .map(|p| {
+                let axis = (0..3)
+                    .max_by(|&i, &j| p[i].abs().total_cmp(&p[j].abs()))
+                    .unwrap();
+                (2 * axis + usize::from(p[axis] < 0.0)) as i32
+            })
+            .collect()
+    }
+
+    /// [`region_point_map`] from `b` to `a` with the test options.
+    fn map_between(
+        a: &TriMesh,
+        b: &TriMesh,
+        da: &ShapeData,
+        db: &ShapeData,
+        la: &[i32],
+        lb: &[i32],
+    ) -> Vec<u32> {
+        region_point_map(
+            &MapShape {
+                spectrum: &da.spectrum,
+                positions: a.positions(),
+                labels: la,
+            },
+            &MapShape {
+                spectrum: &db.spectrum,
+                positions: b.positions(),
+                labels: lb,
+            },
+            &options(),
+        )
+        .unwrap()
+    }
+
+    /// A = the blob, B = the same blob with its vertices permuted (`perm[new] = old`).
+    fn permuted_pair() -> (TriMesh, TriMesh, Vec<usize>, ShapeData, ShapeData) {
+        let a = blob(3);
+        let perm = permutation(a.vertex_count(), 11);
+        let b = permute_mesh(&a, &perm);
+        let (da, db) = (
+            compute_shape_data(&a, &small_pipeline()).unwrap(),
+            compute_shape_data(&b, &small_pipeline()).unwrap(),
+        );
+        (a, b, perm, da, db)
+    }
+
+    fn regions_of(la: &[i32], lb: &[i32]) -> StableRegions {
+        let count = la.iter().chain(lb).copied().max().unwrap() as usize + 1;
+        let members = |l: &[i32], r: usize| {
+            (0..l.len() as u32)
+                .filter(|&v| l[v as usize] == r as i32)
+                .collect::<Vec<u32>>()
+        };
+        StableRegions {
+            vertices_a: la.len(),
+            vertices_b: lb.len(),
+            pairs: (0..count)
+                .map(|r| RegionPair {
+                    region_a: members(la, r),
+                    region_b: members(lb, r),
+                    area_fraction_a: 0.0,
+                    area_fraction_b: 0.0,
+                    objective: 0.0,
+                    iterations: 3,
+                    converged: true,
+                    leftover: false,
+                    auto: None,
+                })
+                .collect(),
+        }
+    }
+
+    #[test]
+    fn region_point_map_recovers_a_vertex_permutation() {
+        let (a, b, perm, da, db) = permuted_pair();
+        let la = patches(&a);
+        let lb: Vec<i32> = perm.iter().map(|&old| la[old]).collect();
+        let map = map_between(&a, &b, &da, &db, &la, &lb);
+        assert_eq!(map.len(), b.vertex_count());
+        // 40 eigenfunctions cannot tell neighbouring vertices of a 642-vertex mesh apart
+        // everywhere: most land exactly, all land close.
+        let exact = map
+            .iter()
+            .zip(&perm)
+            .filter(|&(&p, &old)| p as usize == old)
+            .count();
+        let pos = a.positions();
+        let far = map
+            .iter()
+            .zip(&perm)
+            .map(|(&p, &old)| {
+                let (x, y) = (pos[p as usize], pos[old]);
+                ((x[0] - y[0]).powi(2) + (x[1] - y[1]).powi(2) + (x[2] - y[2]).powi(2)).sqrt()
+            })
+            .fold(0.0, f64::max);
+        eprintln!("{exact} of {} exact, farthest {far:.3}", perm.len());
+        assert!(
+            exact as f64 >= 0.75 * perm.len() as f64,
+            "{exact} of {} vertices mapped to themselves",
+            perm.len()
+        );
+        assert!(far < 0.3, "a vertex landed {far} away");
+    }
+
+    #[test]
+    fn region_point_map_is_deterministic_and_validates_options() {
+        let (a, _, _, da, _) = permuted_pair();
+        let la = patches(&a);
+        let shape = MapShape {
+            spectrum: &da.spectrum,
+            positions: a.positions(),
+            labels: &la,
+        };
+        let first = region_point_map(&shape, &shape, &options()).unwrap();
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        let second = pool.install(|| region_point_map(&shape, &shape, &options()).unwrap());
+        assert_eq!(first, second);
+        let too_big = PointMapOptions {
+            initial_size: 41,
+            ..options()
+        };
+        assert!(region_point_map(&shape, &shape, &too_big).is_err());
+        let short = MapShape {
+            labels: &la[1..],
+            ..shape
+        };
+        assert!(region_point_map(&shape, &short, &options()).is_err());
+        let none = vec![-1; la.len()];
+        let unlabelled = MapShape {
+            labels: &none,
+            ..shape
+        };
+        assert!(region_point_map(&unlabelled, &unlabelled, &options()).is_err());
+    }
+
+    #[test]
+    fn map_guided_refinement_blends_band_scores_and_the_map() {
+        let (a, b, perm, da, db) = permuted_pair();
+        let la = patches(&a);
+        // B starts from the true partition with every fifth vertex in the wrong region.
+        let truth: Vec<i32> = perm.iter().map(|&old| la[old]).collect();
+        let lb: Vec<i32> = truth
+            .iter()
+            .enumerate()
+            .map(|(q, &l)| if q % 5 == 0 { (l + 1) % 6 } else { l })
+            .collect();
+        let regions = regions_of(&la, &lb);
+        let w = BandAffinity::new(&da.bands, &db.bands).unwrap();
+        let (ga, gb) = (
+            ShapeGeometry {
+                spectrum: &da.spectrum,
+                positions: a.positions(),
+            },
+            ShapeGeometry {
+                spectrum: &db.spectrum,
+                positions: b.positions(),
+            },
+        );
+        let run = |weight: f64| {
+            let opts = MapGuidedOptions {
+                point_map: options(),
+                map_weight: weight,
+            };
+            map_guided_refinement(&w, &regions, ga, gb, None, &opts).unwrap()
+        };
+        // Weight 0: exactly the band-affinity best response to A's regions.
+        let mut scores = region_scores(&w, Direction::AtoB, &la, 6, &mut w.workspace()).unwrap();
+        let (best_response, _) = assign_regions(&mut scores, 6, None).unwrap();
+        let band_only = run(0.0);
+        assert_eq!(band_only.labels_b(), best_response);
+        assert_eq!(band_only.labels_a(), la);
+        // A dominant weight: A's labels carried through the point map fitted to the input
+        // partitions.
+        let map = map_between(&a, &b, &da, &db, &la, &lb);
+        let carried: Vec<i32> = map.iter().map(|&p| la[p as usize]).collect();
+        let mapped = run(1e6);
+        assert_eq!(mapped.labels_b(), carried);
+        // The default blend lands on the true partition almost everywhere.
+        let blended = run(1.0);
+        let agree = blended
+            .labels_b()
+            .iter()
+            .zip(&truth)
+            .filter(|(x, y)| x == y)
+            .count();
+        assert!(
+            agree as f64 >= 0.9 * truth.len() as f64,
+            "{agree} of {}",
+            truth.len()
+        );
+        // Pairs keep their order and metadata; B is partitioned; fractions are areas.
+        assert_eq!(blended.pairs.len(), 6);
+        assert!(
+            blended
+                .pairs
+                .iter()
+                .all(|p| p.iterations == 3 && p.converged)
+        );
+        let total: f64 = blended.pairs.iter().map(|p| p.area_fraction_b).sum();
+        assert!((total - 1.0).abs() < 1e-9);
+        assert!(
+            map_guided_refinement(
+                &w,
+                &regions,
+                ga,
+                gb,
+                None,
+                &MapGuidedOptions {
+                    map_weight: -1.0,
+                    ..Default::default()
+                }
+            )
+            .is_err()
+        );
+    }
+}

@@ -8,8 +8,9 @@ use coseg::mesh::read_mesh_with_report;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
 use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, RefineOptions, StableRegionsOptions, TSearch, Threshold,
-    VertexMap, correspondence_ratio, refine_regions, stable_regions,
+    Algorithm, AreaReference, Init, MapGuidedOptions, PointMapOptions, RefineOptions,
+    ShapeGeometry, StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio,
+    map_guided_refinement, refine_regions, stable_regions,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -81,6 +82,14 @@ pub struct PairArgs {
     /// Heat-smoothing time of the refinement (unit-area surface; 0 = no smoothing).
     #[arg(long, default_value_t = RefineOptions::default().smoothing_time)]
     smoothing_time: f64,
+    /// Weight of the point map's vote in the last step, which re-assigns B's vertices by band
+    /// affinity plus a functional-map point map fitted to the region pairs (see
+    /// `coseg::stable::map_guided_refinement`); 0 skips the step.
+    #[arg(long, default_value_t = MapGuidedOptions::default().map_weight)]
+    map_weight: f64,
+    /// Size of the last functional map of that step (capped by the eigenpairs computed).
+    #[arg(long, default_value_t = PointMapOptions::default().final_size)]
+    map_size: usize,
     /// Ground truth for the correspondence ratio: `identity`, or a file with one B index per
     /// vertex of A (negative = none).
     #[arg(long)]
@@ -157,17 +166,25 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         max_rounds: args.refine_rounds,
         smoothing_time: args.smoothing_time,
     });
+    let map_guided = (args.map_weight > 0.0).then(|| MapGuidedOptions {
+        point_map: PointMapOptions {
+            final_size: args.map_size,
+            ..Default::default()
+        },
+        map_weight: args.map_weight,
+    });
+    let smoothing_time = args.smoothing_time;
+    let smoothers = if (refine.is_some() || map_guided.is_some()) && smoothing_time > 0.0 {
+        let sa = HeatSmoother::new(ma, smoothing_time)
+            .with_context(|| format!("smoothing on {}", args.a.display()))?;
+        let sb = HeatSmoother::new(mb, smoothing_time)
+            .with_context(|| format!("smoothing on {}", args.b.display()))?;
+        Some((sa, sb))
+    } else {
+        None
+    };
+    let w = BandAffinity::new(&da.bands, &db.bands)?;
     if let Some(refine) = &refine {
-        let smoothers = if refine.smoothing_time > 0.0 {
-            let sa = HeatSmoother::new(ma, refine.smoothing_time)
-                .with_context(|| format!("smoothing on {}", args.a.display()))?;
-            let sb = HeatSmoother::new(mb, refine.smoothing_time)
-                .with_context(|| format!("smoothing on {}", args.b.display()))?;
-            Some((sa, sb))
-        } else {
-            None
-        };
-        let w = BandAffinity::new(&da.bands, &db.bands)?;
         regions = refine_regions(
             &w,
             &regions,
@@ -176,6 +193,22 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             smoothers.as_ref().map(|s| &s.0),
             smoothers.as_ref().map(|s| &s.1),
             refine,
+        )?;
+    }
+    if let Some(options) = &map_guided {
+        regions = map_guided_refinement(
+            &w,
+            &regions,
+            ShapeGeometry {
+                spectrum: &da.spectrum,
+                positions: ma.positions(),
+            },
+            ShapeGeometry {
+                spectrum: &db.spectrum,
+                positions: mb.positions(),
+            },
+            smoothers.as_ref().map(|s| &s.1),
+            options,
         )?;
     }
     let seconds = t.elapsed().as_secs_f64();
@@ -209,7 +242,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         ratio,
         seconds,
     )
-    .with_refine(refine);
+    .with_refine(refine)
+    .with_map_guided(map_guided);
     let shapes = [
         ShapeRegions {
             name: &na,

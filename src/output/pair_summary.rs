@@ -1,6 +1,6 @@
 //! [`PairSummary`]: the `summary.json` of a two-shape stable-region run.
 
-use crate::stable::{RefineOptions, StableRegions, StableRegionsOptions};
+use crate::stable::{MapGuidedOptions, RefineOptions, StableRegions, StableRegionsOptions};
 use serde::Serialize;
 
 /// One shape of a pair run.
@@ -49,6 +49,9 @@ pub struct PairSummary {
     /// The boundary refinement applied after the algorithm, if any (then `iterations` and
     /// `converged` of every region report the refinement's rounds).
     pub refine: Option<RefineOptions>,
+    /// The map-guided refinement of B's regions applied last, if any (see
+    /// [`map_guided_refinement`](crate::stable::map_guided_refinement)).
+    pub map_guided: Option<MapGuidedOptions>,
     /// Per-region statistics, in region-id order.
     pub regions: Vec<RegionSummary>,
     /// Correspondence ratio against the given ground truth, if any (fraction in `[0, 1]`).
@@ -98,6 +101,7 @@ impl PairSummary {
             shapes,
             options: options.clone(),
             refine: None,
+            map_guided: None,
             regions,
             correspondence_ratio,
             seconds,
@@ -108,6 +112,13 @@ impl PairSummary {
     /// [`refine_regions`](crate::stable::refine_regions)).
     pub fn with_refine(mut self, refine: Option<RefineOptions>) -> Self {
         self.refine = refine;
+        self
+    }
+
+    /// Records that B's regions were re-assigned by
+    /// [`map_guided_refinement`](crate::stable::map_guided_refinement) with `options`.
+    pub fn with_map_guided(mut self, options: Option<MapGuidedOptions>) -> Self {
+        self.map_guided = options;
         self
     }
 }

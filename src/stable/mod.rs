@@ -8,12 +8,16 @@
 //! - [`stable_regions`]: one call from two band tables.
 //! - [`refine_partition`]: smoothed best-response refinement of two corresponding partitions.
 //! - [`refine_regions`]: the same on the output of Algorithms 2 and 3.
+//! - [`region_point_map`]: a vertex map from corresponding regions (functional map + ZoomOut).
+//! - [`map_guided_refinement`]: B's regions re-assigned by band affinity and that map.
 //! - [`correspondence_ratio`]: quality against a ground-truth map (paper §7.2).
 
 mod correspondence_ratio;
 mod initial_indicator;
+mod map_guided_refinement;
 mod refine_partition;
 mod refine_regions;
+mod region_point_map;
 mod stable_pair;
 mod stable_pairs_auto;
 mod stable_pairs_fixed;
@@ -24,10 +28,12 @@ pub use correspondence_ratio::{
     CorrespondenceStats, VertexMap, correspondence_ratio, correspondence_stats,
 };
 pub use initial_indicator::{Init, initial_indicator};
+pub use map_guided_refinement::{MapGuidedOptions, ShapeGeometry, map_guided_refinement};
 pub use refine_partition::{
     RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
 };
 pub use refine_regions::refine_regions;
+pub use region_point_map::{MapShape, PointMapOptions, region_point_map};
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
 };

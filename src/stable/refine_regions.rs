@@ -50,6 +50,31 @@ pub fn refine_regions(
         smoother_b,
         options,
     )?;
+    rebuild_regions(
+        w,
+        regions,
+        &refined.labels_a,
+        &refined.labels_b,
+        areas_a,
+        areas_b,
+        refined.rounds,
+        refined.converged,
+    )
+}
+
+/// New pairs from labels (pair `i` = label `i`, same meaning and order as `regions`), with
+/// their area fractions and objectives; `iterations` and `converged` are set on every pair.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn rebuild_regions(
+    w: &BandAffinity<'_>,
+    regions: &StableRegions,
+    labels_a: &[i32],
+    labels_b: &[i32],
+    areas_a: &[f64],
+    areas_b: &[f64],
+    iterations: usize,
+    converged: bool,
+) -> Result<StableRegions, StableError> {
     let n = regions.pairs.len();
     let members = |labels: &[i32]| {
         let mut m: Vec<Vec<u32>> = vec![Vec::new(); n];
@@ -60,7 +85,7 @@ pub fn refine_regions(
         }
         m
     };
-    let (ma, mb) = (members(&refined.labels_a), members(&refined.labels_b));
+    let (ma, mb) = (members(labels_a), members(labels_b));
     let (total_a, total_b): (f64, f64) = (areas_a.iter().sum(), areas_b.iter().sum());
     let area = |set: &[u32], areas: &[f64], total: f64| {
         set.iter().map(|&v| areas[v as usize]).sum::<f64>() / total
@@ -82,8 +107,8 @@ pub fn refine_regions(
             region_a: ra,
             region_b: rb,
             objective,
-            iterations: refined.rounds,
-            converged: refined.converged,
+            iterations,
+            converged,
             leftover: old.leftover,
             auto: old.auto,
         });

@@ -1,0 +1,152 @@
+//! [`map_guided_refinement`]: re-assign B's vertices to the regions of A by their band
+//! affinity together with a point map read from the region correspondence itself.
+
+use super::refine_regions::rebuild_regions;
+use super::{
+    MapShape, PointMapOptions, StableError, StableRegions, region_point_map, region_scores,
+};
+use crate::affinity::{BandAffinity, Direction};
+use crate::spectral::{HeatSmoother, Spectrum};
+use serde::{Deserialize, Serialize};
+
+/// Options of [`map_guided_refinement`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MapGuidedOptions {
+    /// The point map's options.
+    pub point_map: PointMapOptions,
+    /// Weight `β` of the point map's vote against the band affinity, which is scaled to a
+    /// best score of 1 at every vertex (default 1: equal say; `0` ignores the map).
+    pub map_weight: f64,
+}
+
+impl Default for MapGuidedOptions {
+    fn default() -> Self {
+        MapGuidedOptions {
+            point_map: PointMapOptions::default(),
+            map_weight: 1.0,
+        }
+    }
+}
+
+/// What [`map_guided_refinement`] needs of a shape besides its band table.
+#[derive(Debug, Clone, Copy)]
+pub struct ShapeGeometry<'a> {
+    /// Unit-area spectrum; its lumped masses are the vertex areas of the rebuilt pairs.
+    pub spectrum: &'a Spectrum,
+    /// Vertex positions.
+    pub positions: &'a [[f64; 3]],
+}
+
+/// Sharpens B's side of corresponding partitions with a point map. A's regions are kept; every
+/// vertex `q` of B takes the region `r` maximising, after heat smoothing over B,
+///
+/// `S_r(q) / max_s S_s(q) + β · [label_A(T(q)) = r]`,
+///
+/// where `S_r` is the mean band affinity of `q` to A's region `r` ([`region_scores`], the
+/// score [`refine_partition`](super::refine_partition) uses) and `T` is
+/// [`region_point_map`] fitted to the current partitions.
+///
+/// Why: the band affinity only sees a vertex's own descriptor row, so where descriptors vary
+/// slowly (the torso of an animal) a boundary drifts. The point map is fitted to every region
+/// pair at once and is smooth in the spectral basis, so it places a boundary by the whole
+/// shape's layout; the band score keeps the map's local failures from overruling the
+/// descriptors. On TOSCA within-class pairs it lifts Algorithm 2 + refinement from 92.3 % to
+/// 93.6 % (README).
+///
+/// The result has the same pairs in the same order, with new vertex sets of B, area fractions
+/// (from the spectra's lumped masses) and objectives; `iterations` and `converged` are
+/// carried over. Deterministic.
+///
+/// ```no_run
+/// # fn main() -> Result<(), Box<dyn std::error::Error>> {
+/// use coseg::affinity::BandAffinity;
+/// use coseg::cache::{compute_shape_data, ShapePipelineOptions};
+/// use coseg::mesh::read_mesh;
+/// use coseg::spectral::HeatSmoother;
+/// use coseg::stable::*;
+/// let (ma, mb) = (read_mesh("cat0.off")?, read_mesh("cat1.off")?);
+/// let pipe = ShapePipelineOptions::default();
+/// let (da, db) = (compute_shape_data(&ma, &pipe)?, compute_shape_data(&mb, &pipe)?);
+/// let (aa, ab) = (ma.vertex_areas(), mb.vertex_areas());
+/// let regions = stable_regions(&da.bands, &db.bands, &aa, &ab, &StableRegionsOptions::default())?;
+/// let w = BandAffinity::new(&da.bands, &db.bands)?;
+/// let sb = HeatSmoother::new(&mb, 3e-3)?;
+/// let sharpened = map_guided_refinement(
+///     &w,
+///     &regions,
+///     ShapeGeometry { spectrum: &da.spectrum, positions: ma.positions() },
+///     ShapeGeometry { spectrum: &db.spectrum, positions: mb.positions() },
+///     Some(&sb),
+///     &MapGuidedOptions::default(),
+/// )?;
+/// assert_eq!(sharpened.pairs.len(), regions.pairs.len());
+/// # Ok(()) }
+/// ```
+pub fn map_guided_refinement(
+    w: &BandAffinity<'_>,
+    regions: &StableRegions,
+    a: ShapeGeometry<'_>,
+    b: ShapeGeometry<'_>,
+    smoother_b: Option<&HeatSmoother>,
+    options: &MapGuidedOptions,
+) -> Result<StableRegions, StableError> {
+    if !(options.map_weight.is_finite() && options.map_weight >= 0.0) {
+        return Err(StableError::BadOption(format!(
+            "map_weight = {} must be finite and non-negative",
+            options.map_weight
+        )));
+    }
+    if a.spectrum.vertex_count() != regions.vertices_a
+        || b.spectrum.vertex_count() != regions.vertices_b
+    {
+        return Err(StableError::BadOption(format!(
+            "spectra of {} and {} vertices for regions on {} and {}",
+            a.spectrum.vertex_count(),
+            b.spectrum.vertex_count(),
+            regions.vertices_a,
+            regions.vertices_b
+        )));
+    }
+    let count = regions.pairs.len();
+    let (labels_a, labels_b) = (regions.labels_a(), regions.labels_b());
+    let map = region_point_map(
+        &MapShape {
+            spectrum: a.spectrum,
+            positions: a.positions,
+            labels: &labels_a,
+        },
+        &MapShape {
+            spectrum: b.spectrum,
+            positions: b.positions,
+            labels: &labels_b,
+        },
+        &options.point_map,
+    )?;
+    let mut scores = region_scores(w, Direction::AtoB, &labels_a, count, &mut w.workspace())?;
+    let d = regions.vertices_b;
+    for (q, &p) in map.iter().enumerate() {
+        let best = (0..count).map(|r| scores[r * d + q]).fold(0.0, f64::max);
+        if best > 0.0 {
+            (0..count).for_each(|r| scores[r * d + q] /= best);
+        }
+        let voted = labels_a[p as usize];
+        if voted >= 0 {
+            scores[voted as usize * d + q] += options.map_weight;
+        }
+    }
+    let (new_b, _) = super::assign_regions(&mut scores, count, smoother_b)?;
+    let (iterations, converged) = regions
+        .pairs
+        .first()
+        .map_or((0, true), |p| (p.iterations, p.converged));
+    rebuild_regions(
+        w,
+        regions,
+        &labels_a,
+        &new_b,
+        &a.spectrum.vertex_areas,
+        &b.spectrum.vertex_areas,
+        iterations,
+        converged,
+    )
+}
