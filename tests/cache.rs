@@ -11,13 +11,7 @@ use coseg::cache::{
 use coseg::mesh::TriMesh;
 
 fn opts() -> ShapePipelineOptions {
-    let mut o = ShapePipelineOptions::default();
-    o.spectrum.eigenpairs = 20;
-    o.descriptors.hks_count = 6;
-    o.descriptors.wks_count = 6;
-    o.descriptors.curvature_count = 6;
-    o.bands.bands = 8;
-    o
+    common::features::small_pipeline(20, 6)
 }
 
 fn mesh() -> TriMesh {

@@ -803,13 +803,7 @@ mod map_guided {
     };
 
     fn small_pipeline() -> ShapePipelineOptions {
-        let mut p = ShapePipelineOptions::default();
-        p.spectrum.eigenpairs = 40;
-        p.descriptors.hks_count = 10;
-        p.descriptors.wks_count = 10;
-        p.descriptors.curvature_count = 10;
-        p.bands.bands = 8;
-        p
+        super::common::features::small_pipeline(40, 10)
     }
 
     fn options() -> PointMapOptions {

@@ -90,3 +90,15 @@ pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
         .sum();
     1.0 - 6.0 * d2 / (n * (n * n - 1.0))
 }
+
+/// A small pipeline for tests: `eigenpairs` eigenpairs, `per_kind` HKS, WKS and curvature
+/// features each, 8 bands.
+pub fn small_pipeline(eigenpairs: usize, per_kind: usize) -> coseg::cache::ShapePipelineOptions {
+    let mut o = coseg::cache::ShapePipelineOptions::default();
+    o.spectrum.eigenpairs = eigenpairs;
+    o.descriptors.hks_count = per_kind;
+    o.descriptors.wks_count = per_kind;
+    o.descriptors.curvature_count = per_kind;
+    o.bands.bands = 8;
+    o
+}
