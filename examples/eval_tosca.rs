@@ -236,8 +236,8 @@ fn main() -> anyhow::Result<()> {
                     let t = Instant::now();
                     let mut r =
                         stable_regions(&data[a].2, &data[b].2, &data[a].1, &data[b].1, opts)?;
+                    let w = BandAffinity::new(&data[a].2, &data[b].2)?;
                     if *post != Post::None {
-                        let w = BandAffinity::new(&data[a].2, &data[b].2)?;
                         r = refine_regions(
                             &w,
                             &r,
@@ -249,7 +249,6 @@ fn main() -> anyhow::Result<()> {
                         )?;
                     }
                     if *post == Post::RefineMap {
-                        let w = BandAffinity::new(&data[a].2, &data[b].2)?;
                         r = map_guided_refinement(
                             &w,
                             &r,
