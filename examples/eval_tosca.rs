@@ -9,16 +9,20 @@
 //! every unordered pair is segmented; the table gives the mean ratio per class and overall for
 //! each configuration (Algorithm 2 at a 10 % area cutoff, Algorithm 3), plus the time spent in
 //! the stable-region algorithm (per-shape data are cached and excluded).
+//!
+//! The `*-oracle-*` configurations are diagnostics, not methods: they replace the map step's
+//! map by ZoomOut started from the ground truth, to measure what a perfect start of the map
+//! would buy.
 
 use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
 use coseg::cache::{ShapePipelineOptions, load_or_compute};
 use coseg::mesh::read_mesh;
-use coseg::spectral::HeatSmoother;
+use coseg::spectral::{HeatSmoother, ZoomOutOptions, zoomout};
 use coseg::stable::{
     Algorithm, AreaReference, Init, MapGuidedOptions, RefineOptions, ShapeGeometry,
     StableRegionsOptions, TSearch, VertexMap, correspondence_stats, map_guided_refinement,
-    refine_regions, stable_regions,
+    point_map_refinement, refine_regions, stable_regions,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -31,6 +35,10 @@ enum Post {
     Refine,
     /// [`refine_regions`], then [`map_guided_refinement`], default options.
     RefineMap,
+    /// Diagnostic, not a method: [`refine_regions`], then [`point_map_refinement`] with
+    /// weight `β` and a ZoomOut map started from the ground truth (what the map step would
+    /// give if its map were as good as ZoomOut can make it).
+    RefineOracleMap(f64),
 }
 
 /// `(name, options, post-processing)`.
@@ -112,6 +120,22 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, Post)> {
                 ..base.clone()
             },
             Post::RefineMap,
+        ),
+        (
+            "alg2-random-oracle-map",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..base.clone()
+            },
+            Post::RefineOracleMap(MapGuidedOptions::default().map_weight),
+        ),
+        (
+            "alg2-random-oracle-transfer",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..base.clone()
+            },
+            Post::RefineOracleMap(1e6),
         ),
         (
             "alg3-random-mapped",
@@ -248,18 +272,36 @@ fn main() -> anyhow::Result<()> {
                             &RefineOptions::default(),
                         )?;
                     }
+                    let (ga, gb) = (
+                        ShapeGeometry {
+                            spectrum: &data[a].4,
+                            positions: &data[a].5,
+                        },
+                        ShapeGeometry {
+                            spectrum: &data[b].4,
+                            positions: &data[b].5,
+                        },
+                    );
+                    if let Post::RefineOracleMap(weight) = *post {
+                        // Within a class the identity is the ground truth.
+                        let truth: Vec<u32> = (0..data[b].1.len() as u32).collect();
+                        let map = zoomout(ga, gb, &truth, &ZoomOutOptions::default())?;
+                        r = point_map_refinement(
+                            &w,
+                            &r,
+                            &map,
+                            &data[a].4.vertex_areas,
+                            &data[b].4.vertex_areas,
+                            Some(&data[b].3),
+                            weight,
+                        )?;
+                    }
                     if *post == Post::RefineMap {
                         r = map_guided_refinement(
                             &w,
                             &r,
-                            ShapeGeometry {
-                                spectrum: &data[a].4,
-                                positions: &data[a].5,
-                            },
-                            ShapeGeometry {
-                                spectrum: &data[b].4,
-                                positions: &data[b].5,
-                            },
+                            ga,
+                            gb,
                             Some(&data[b].3),
                             &MapGuidedOptions::default(),
                         )?;

@@ -797,9 +797,11 @@ mod map_guided {
     use coseg::affinity::{BandAffinity, Direction};
     use coseg::cache::{ShapeData, ShapePipelineOptions, compute_shape_data};
     use coseg::mesh::TriMesh;
+    use coseg::spectral::ZoomOutOptions;
     use coseg::stable::{
         MapGuidedOptions, MapShape, PointMapOptions, RegionPair, ShapeGeometry, StableRegions,
-        assign_regions, map_guided_refinement, region_point_map, region_scores,
+        assign_regions, map_guided_refinement, point_map_refinement, region_point_map,
+        region_scores,
     };
 
     fn small_pipeline() -> ShapePipelineOptions {
@@ -808,10 +810,12 @@ mod map_guided {
 
     fn options() -> PointMapOptions {
         PointMapOptions {
-            initial_size: 6,
-            final_size: 40,
-            step: 5,
-            samples: 300,
+            zoomout: ZoomOutOptions {
+                initial_size: 6,
+                final_size: 40,
+                step: 5,
+                samples: 300,
+            },
             ..Default::default()
         }
     }
@@ -940,10 +944,8 @@ mod map_guided {
             .unwrap();
         let second = pool.install(|| region_point_map(&shape, &shape, &options()).unwrap());
         assert_eq!(first, second);
-        let too_big = PointMapOptions {
-            initial_size: 41,
-            ..options()
-        };
+        let mut too_big = options();
+        too_big.zoomout.initial_size = 41;
         assert!(region_point_map(&shape, &shape, &too_big).is_err());
         let short = MapShape {
             labels: &la[1..],
@@ -1037,5 +1039,17 @@ mod map_guided {
             )
             .is_err()
         );
+        // The same blend with the map handed in.
+        let (areas_a, areas_b) = (&da.spectrum.vertex_areas, &db.spectrum.vertex_areas);
+        let handed = point_map_refinement(&w, &regions, &map, areas_a, areas_b, None, 1.0);
+        assert_eq!(handed.unwrap(), blended);
+        let refine_with = |m: &[u32], weight: f64| {
+            point_map_refinement(&w, &regions, m, areas_a, areas_b, None, weight)
+        };
+        assert!(refine_with(&map[1..], 1.0).is_err());
+        let mut outside = map.clone();
+        outside[3] = la.len() as u32;
+        assert!(refine_with(&outside, 1.0).is_err());
+        assert!(refine_with(&map, f64::NAN).is_err());
     }
 }

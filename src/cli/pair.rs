@@ -6,7 +6,7 @@ use coseg::affinity::BandAffinity;
 use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
 use coseg::mesh::read_mesh_with_report;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
-use coseg::spectral::HeatSmoother;
+use coseg::spectral::{HeatSmoother, ZoomOutOptions};
 use coseg::stable::{
     Algorithm, AreaReference, Init, MapGuidedOptions, PointMapOptions, RefineOptions,
     ShapeGeometry, StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio,
@@ -88,7 +88,7 @@ pub struct PairArgs {
     #[arg(long, default_value_t = MapGuidedOptions::default().map_weight)]
     map_weight: f64,
     /// Size of the last functional map of that step (capped by the eigenpairs computed).
-    #[arg(long, default_value_t = PointMapOptions::default().final_size)]
+    #[arg(long, default_value_t = ZoomOutOptions::default().final_size)]
     map_size: usize,
     /// Ground truth for the correspondence ratio: `identity`, or a file with one B index per
     /// vertex of A (negative = none).
@@ -168,7 +168,10 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     });
     let map_guided = (args.map_weight > 0.0).then(|| MapGuidedOptions {
         point_map: PointMapOptions {
-            final_size: args.map_size,
+            zoomout: ZoomOutOptions {
+                final_size: args.map_size,
+                ..Default::default()
+            },
             ..Default::default()
         },
         map_weight: args.map_weight,

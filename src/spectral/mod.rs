@@ -11,6 +11,7 @@ mod heat_smoother;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
 mod shift_invert;
+pub(crate) mod zoomout;
 
 pub use cotan_laplacian::cotan_laplacian;
 pub use heat_smoother::HeatSmoother;
@@ -19,6 +20,7 @@ pub use laplace_beltrami_spectrum::{
     laplace_beltrami_spectrum_with_stats,
 };
 pub use lumped_mass::lumped_mass;
+pub use zoomout::{ShapeGeometry, ZoomOutOptions, zoomout};
 
 use thiserror::Error;
 

@@ -6,7 +6,7 @@ use super::{
     MapShape, PointMapOptions, StableError, StableRegions, region_point_map, region_scores,
 };
 use crate::affinity::{BandAffinity, Direction};
-use crate::spectral::{HeatSmoother, Spectrum};
+use crate::spectral::{HeatSmoother, ShapeGeometry};
 use serde::{Deserialize, Serialize};
 
 /// Options of [`map_guided_refinement`].
@@ -26,15 +26,6 @@ impl Default for MapGuidedOptions {
             map_weight: 1.0,
         }
     }
-}
-
-/// What [`map_guided_refinement`] needs of a shape besides its band table.
-#[derive(Debug, Clone, Copy)]
-pub struct ShapeGeometry<'a> {
-    /// Unit-area spectrum; its lumped masses are the vertex areas of the rebuilt pairs.
-    pub spectrum: &'a Spectrum,
-    /// Vertex positions.
-    pub positions: &'a [[f64; 3]],
 }
 
 /// Sharpens B's side of corresponding partitions with a point map. A's regions are kept; every
@@ -107,7 +98,6 @@ pub fn map_guided_refinement(
             regions.vertices_b
         )));
     }
-    let count = regions.pairs.len();
     let (labels_a, labels_b) = (regions.labels_a(), regions.labels_b());
     let map = region_point_map(
         &MapShape {
@@ -122,8 +112,73 @@ pub fn map_guided_refinement(
         },
         &options.point_map,
     )?;
-    let mut scores = region_scores(w, Direction::AtoB, &labels_a, count, &mut w.workspace())?;
+    point_map_refinement(
+        w,
+        regions,
+        &map,
+        &a.spectrum.vertex_areas,
+        &b.spectrum.vertex_areas,
+        smoother_b,
+        options.map_weight,
+    )
+}
+
+/// The blend of [`map_guided_refinement`] with a point map `map` from B to A given by the
+/// caller (`map[q]` is a vertex of A for every vertex `q` of B), for instance one from
+/// another correspondence method or [`zoomout`](crate::spectral::zoomout) from a known map.
+/// `areas_a`, `areas_b` are the vertex areas the rebuilt pairs' area fractions use; `β` is
+/// `map_weight`.
+///
+/// ```
+/// use coseg::affinity::BandAffinity;
+/// use coseg::bands::equal_count_bands;
+/// use coseg::stable::{point_map_refinement, RegionPair, StableRegions};
+/// // Four vertices on a line, one feature; A = B, two regions {0, 1} and {2, 3}.
+/// let t = equal_count_bands(&[0.0, 1.0, 2.0, 3.0], 1, 4, 2).unwrap();
+/// let w = BandAffinity::new(&t, &t).unwrap();
+/// let pair = |v: Vec<u32>| RegionPair {
+///     region_a: v.clone(), region_b: v, area_fraction_a: 0.5, area_fraction_b: 0.5,
+///     objective: 0.0, iterations: 1, converged: true, leftover: false, auto: None,
+/// };
+/// let regions = StableRegions { vertices_a: 4, vertices_b: 4, pairs: vec![pair(vec![0, 1]), pair(vec![2, 3])] };
+/// // A map that sends every vertex of B to vertex 3 of A, with a dominant weight.
+/// let out = point_map_refinement(&w, &regions, &[3; 4], &[0.25; 4], &[0.25; 4], None, 10.0).unwrap();
+/// assert_eq!(out.labels_b(), vec![1, 1, 1, 1]);
+/// assert_eq!(out.labels_a(), vec![0, 0, 1, 1]);
+/// ```
+pub fn point_map_refinement(
+    w: &BandAffinity<'_>,
+    regions: &StableRegions,
+    map: &[u32],
+    areas_a: &[f64],
+    areas_b: &[f64],
+    smoother_b: Option<&HeatSmoother>,
+    map_weight: f64,
+) -> Result<StableRegions, StableError> {
+    if !(map_weight.is_finite() && map_weight >= 0.0) {
+        return Err(StableError::BadOption(format!(
+            "map_weight = {map_weight} must be finite and non-negative"
+        )));
+    }
     let d = regions.vertices_b;
+    if map.len() != d || areas_b.len() != d || areas_a.len() != regions.vertices_a {
+        return Err(StableError::BadOption(format!(
+            "a map of {} entries and area vectors of {} and {} for regions on {} and {d} vertices",
+            map.len(),
+            areas_a.len(),
+            areas_b.len(),
+            regions.vertices_a
+        )));
+    }
+    if let Some(&p) = map.iter().find(|&&p| p as usize >= regions.vertices_a) {
+        return Err(StableError::BadOption(format!(
+            "the map sends a vertex to {p}, but A has {} vertices",
+            regions.vertices_a
+        )));
+    }
+    let count = regions.pairs.len();
+    let labels_a = regions.labels_a();
+    let mut scores = region_scores(w, Direction::AtoB, &labels_a, count, &mut w.workspace())?;
     for (q, &p) in map.iter().enumerate() {
         let best = (0..count).map(|r| scores[r * d + q]).fold(0.0, f64::max);
         if best > 0.0 {
@@ -131,7 +186,7 @@ pub fn map_guided_refinement(
         }
         let voted = labels_a[p as usize];
         if voted >= 0 {
-            scores[voted as usize * d + q] += options.map_weight;
+            scores[voted as usize * d + q] += map_weight;
         }
     }
     let (new_b, _) = super::assign_regions(&mut scores, count, smoother_b)?;
@@ -140,13 +195,6 @@ pub fn map_guided_refinement(
         .first()
         .map_or((0, true), |p| (p.iterations, p.converged));
     rebuild_regions(
-        w,
-        regions,
-        &labels_a,
-        &new_b,
-        &a.spectrum.vertex_areas,
-        &b.spectrum.vertex_areas,
-        iterations,
-        converged,
+        w, regions, &labels_a, &new_b, areas_a, areas_b, iterations, converged,
     )
 }

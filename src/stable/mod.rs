@@ -9,7 +9,8 @@
 //! - [`refine_partition`]: smoothed best-response refinement of two corresponding partitions.
 //! - [`refine_regions`]: the same on the output of Algorithms 2 and 3.
 //! - [`region_point_map`]: a vertex map from corresponding regions (functional map + ZoomOut).
-//! - [`map_guided_refinement`]: B's regions re-assigned by band affinity and that map.
+//! - [`map_guided_refinement`]: B's regions re-assigned by band affinity and that map
+//!   ([`point_map_refinement`]: the same with a map of your own).
 //! - [`correspondence_ratio`]: quality against a ground-truth map (paper §7.2).
 
 mod correspondence_ratio;
@@ -24,11 +25,12 @@ mod stable_pairs_fixed;
 mod stable_regions;
 mod threshold;
 
+pub use crate::spectral::ShapeGeometry;
 pub use correspondence_ratio::{
     CorrespondenceStats, VertexMap, correspondence_ratio, correspondence_stats,
 };
 pub use initial_indicator::{Init, initial_indicator};
-pub use map_guided_refinement::{MapGuidedOptions, ShapeGeometry, map_guided_refinement};
+pub use map_guided_refinement::{MapGuidedOptions, map_guided_refinement, point_map_refinement};
 pub use refine_partition::{
     RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
 };
@@ -74,6 +76,9 @@ pub enum StableError {
     /// An option is out of range.
     #[error("invalid option: {0}")]
     BadOption(String),
+    /// The spectral stage (a smoother or a spectral map) rejected its input.
+    #[error(transparent)]
+    Spectral(#[from] crate::spectral::SpectralError),
     /// A ground-truth map is malformed or unreadable (names the file when there is one).
     #[error("ground-truth map: {0}")]
     BadMap(String),

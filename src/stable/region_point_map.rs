@@ -3,39 +3,29 @@
 //! spectrally (ZoomOut).
 
 use super::StableError;
-use crate::spectral::Spectrum;
-use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef, Par};
+use crate::spectral::zoomout::{check_shapes, checked_final_size, eigenvectors, zoomout_from};
+use crate::spectral::{ShapeGeometry, Spectrum, ZoomOutOptions};
+use faer::MatRef;
 use nalgebra::{DMatrix, DVector};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Options of [`region_point_map`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PointMapOptions {
-    /// Size `k₀` of the first functional map, the one fitted to the region indicators
-    /// (default 10: about as many unknowns per row as there are region pairs).
-    pub initial_size: usize,
-    /// Size of the last functional map (default 150, capped by the eigenpairs available).
-    pub final_size: usize,
-    /// Growth of the map's size per ZoomOut step (default 5).
-    pub step: usize,
+    /// The ZoomOut stage; its `initial_size` `k₀` is also the size of the functional map
+    /// fitted to the region indicators (default 10: about as many unknowns per row as there
+    /// are region pairs).
+    pub zoomout: ZoomOutOptions,
     /// Weight of the Laplacian-commutativity term `‖CΛ_A − Λ_B C‖²` of the first fit, with
     /// eigenvalues divided by the largest one used (default 1).
     pub commutativity: f64,
-    /// Vertices per shape (farthest-point samples) on which the ZoomOut steps run; the last
-    /// map is evaluated on every vertex (default 2000).
-    pub samples: usize,
 }
 
 impl Default for PointMapOptions {
     fn default() -> Self {
         PointMapOptions {
-            initial_size: 10,
-            final_size: 150,
-            step: 5,
+            zoomout: ZoomOutOptions::default(),
             commutativity: 1.0,
-            samples: 2000,
         }
     }
 }
@@ -67,7 +57,7 @@ pub struct MapShape<'a> {
 ///
 /// ```
 /// use coseg::mesh::TriMesh;
-/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions};
+/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions, ZoomOutOptions};
 /// use coseg::stable::{region_point_map, MapShape, PointMapOptions};
 /// // A strip of 8 × 2 squares, cut into left and right halves.
 /// let (nx, ny) = (9u32, 3u32);
@@ -82,7 +72,8 @@ pub struct MapShape<'a> {
 /// let spectrum = laplace_beltrami_spectrum(&mesh, &SpectrumOptions { eigenpairs: 12, ..Default::default() }).unwrap();
 /// let labels: Vec<i32> = (0..nx * ny).map(|i| i32::from(i % nx >= 4)).collect();
 /// let shape = MapShape { spectrum: &spectrum, positions: &pos, labels: &labels };
-/// let options = PointMapOptions { initial_size: 4, final_size: 12, step: 4, ..Default::default() };
+/// let zoomout = ZoomOutOptions { initial_size: 4, final_size: 12, step: 4, ..Default::default() };
+/// let options = PointMapOptions { zoomout, ..Default::default() };
 /// let map = region_point_map(&shape, &shape, &options).unwrap();
 /// // Every vertex lands on the same side of the cut.
 /// assert!(map.iter().enumerate().all(|(q, &p)| labels[q] == labels[p as usize]));
@@ -92,57 +83,42 @@ pub fn region_point_map(
     b: &MapShape<'_>,
     options: &PointMapOptions,
 ) -> Result<Vec<u32>, StableError> {
+    let (ga, gb) = (a.geometry(), b.geometry());
+    check_shapes(ga, gb)?;
     for (s, name) in [(a, "A"), (b, "B")] {
         let d = s.spectrum.vertex_count();
-        if s.labels.len() != d || s.positions.len() != d {
+        if s.labels.len() != d {
             return Err(StableError::BadOption(format!(
-                "shape {name}: {} labels and {} positions for a spectrum of {d} vertices",
-                s.labels.len(),
-                s.positions.len()
+                "shape {name}: {} labels for a spectrum of {d} vertices",
+                s.labels.len()
             )));
         }
     }
-    let available = a
-        .spectrum
-        .eigenvalues
-        .len()
-        .min(b.spectrum.eigenvalues.len());
-    let final_size = options.final_size.min(available);
-    if options.initial_size == 0 || options.step == 0 || options.initial_size > final_size {
-        return Err(StableError::BadOption(format!(
-            "point map sizes: initial {} and step {} must be positive, and the initial size at \
-             most the final size {final_size} (eigenpairs available: {available})",
-            options.initial_size, options.step
-        )));
-    }
+    let final_size = checked_final_size(ga, gb, &options.zoomout)?;
     if !(options.commutativity.is_finite() && options.commutativity >= 0.0) {
         return Err(StableError::BadOption(format!(
             "commutativity = {} must be finite and non-negative",
             options.commutativity
         )));
     }
-    let phi_a = eigenvectors(a.spectrum, final_size);
-    let phi_b = eigenvectors(b.spectrum, final_size);
-    let mut c = initial_map(a, b, phi_a, phi_b, options)?;
-
-    let samples_a = sample_rows(phi_a, a.positions, options.samples.max(2 * final_size));
-    let samples_b = sample_rows(phi_b, b.positions, options.samples.max(2 * final_size));
-    let mut k = options.initial_size;
-    while k < final_size {
-        let t = nearest_rows(
-            &pulled_back(samples_a.as_ref(), &c),
-            samples_b.subcols(0, k),
-        );
-        let next = (k + options.step).min(final_size);
-        c = spectral_fit(samples_b.subcols(0, next), samples_a.subcols(0, next), &t)?;
-        k = next;
-    }
-    Ok(nearest_rows(&pulled_back(phi_a, &c), phi_b.subcols(0, k)))
+    let k = options.zoomout.initial_size;
+    let c = initial_map(
+        a,
+        b,
+        eigenvectors(a.spectrum, k),
+        eigenvectors(b.spectrum, k),
+        options,
+    )?;
+    Ok(zoomout_from(ga, gb, c, final_size, &options.zoomout)?)
 }
 
-fn eigenvectors(s: &Spectrum, k: usize) -> MatRef<'_, f64> {
-    let d = s.vertex_count();
-    MatRef::from_column_major_slice(&s.eigenvectors[..d * k], d, k)
+impl MapShape<'_> {
+    fn geometry(&self) -> ShapeGeometry<'_> {
+        ShapeGeometry {
+            spectrum: self.spectrum,
+            positions: self.positions,
+        }
+    }
 }
 
 /// The first functional map, row by row: `(a aᵀ + μ D_i) c_i = a b_i` with
@@ -154,7 +130,7 @@ fn initial_map(
     phi_b: MatRef<'_, f64>,
     options: &PointMapOptions,
 ) -> Result<DMatrix<f64>, StableError> {
-    let k = options.initial_size;
+    let k = options.zoomout.initial_size;
     let regions = a
         .labels
         .iter()
@@ -205,108 +181,4 @@ fn initial_map(
         c.set_row(i, &row.transpose());
     }
     Ok(c)
-}
-
-/// `Φ Cᵀ` over the first `C.ncols()` columns of `Φ`: A's spectral embedding expressed in B's
-/// basis, whose rows are compared with B's rows `Φ_B(q)`.
-fn pulled_back(phi: MatRef<'_, f64>, c: &DMatrix<f64>) -> Mat<f64> {
-    let k = c.ncols();
-    let ct = Mat::from_fn(k, c.nrows(), |i, j| c[(j, i)]);
-    let mut out = Mat::zeros(phi.nrows(), c.nrows());
-    matmul(
-        out.as_mut(),
-        Accum::Replace,
-        phi.subcols(0, k),
-        ct.as_ref(),
-        1.0,
-        Par::Seq,
-    );
-    out
-}
-
-/// Least-squares functional map of a point map on samples: `C = argmin ‖Φ_B C − Φ_A[T]‖`.
-fn spectral_fit(
-    phi_b: MatRef<'_, f64>,
-    phi_a: MatRef<'_, f64>,
-    t: &[u32],
-) -> Result<DMatrix<f64>, StableError> {
-    let k = phi_b.ncols();
-    let b = DMatrix::from_fn(phi_b.nrows(), k, |i, j| phi_b[(i, j)]);
-    let a = DMatrix::from_fn(t.len(), k, |i, j| phi_a[(t[i] as usize, j)]);
-    let btb = b.transpose() * &b;
-    let bta = b.transpose() * a;
-    btb.cholesky()
-        .map(|ch| ch.solve(&bta))
-        .ok_or_else(|| StableError::BadOption("ZoomOut: sampled eigenbasis is singular".into()))
-}
-
-/// Rows of `phi` at `count` farthest-point samples of `positions` (all rows when `count ≥ d`),
-/// starting from vertex 0.
-fn sample_rows(phi: MatRef<'_, f64>, positions: &[[f64; 3]], count: usize) -> Mat<f64> {
-    let d = positions.len();
-    let chosen: Vec<usize> = if count >= d {
-        (0..d).collect()
-    } else {
-        let mut dist = vec![f64::INFINITY; d];
-        let mut out = Vec::with_capacity(count);
-        let mut current = 0usize;
-        for _ in 0..count {
-            out.push(current);
-            let c = positions[current];
-            let mut far = (-1.0, 0usize);
-            for (i, p) in positions.iter().enumerate() {
-                let d2 = (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2);
-                if d2 < dist[i] {
-                    dist[i] = d2;
-                }
-                if dist[i] > far.0 {
-                    far = (dist[i], i);
-                }
-            }
-            current = far.1;
-        }
-        out
-    };
-    Mat::from_fn(chosen.len(), phi.ncols(), |i, j| phi[(chosen[i], j)])
-}
-
-/// Rows of `query` per block: fixed, so the result does not depend on the thread count.
-const QUERY_BLOCK: usize = 128;
-
-/// For every row of `query`, the index of the nearest row of `base` (Euclidean; ties to the
-/// lowest index). Both have the same number of columns.
-fn nearest_rows(base: &Mat<f64>, query: MatRef<'_, f64>) -> Vec<u32> {
-    let n = base.nrows();
-    let norms: Vec<f64> = (0..n)
-        .map(|i| (0..base.ncols()).map(|j| base[(i, j)] * base[(i, j)]).sum())
-        .collect();
-    let starts: Vec<usize> = (0..query.nrows()).step_by(QUERY_BLOCK).collect();
-    starts
-        .par_iter()
-        .flat_map_iter(|&r0| {
-            let m = QUERY_BLOCK.min(query.nrows() - r0);
-            let mut dots = Mat::<f64>::zeros(n, m);
-            matmul(
-                dots.as_mut(),
-                Accum::Replace,
-                base.as_ref(),
-                query.subrows(r0, m).transpose(),
-                1.0,
-                Par::Seq,
-            );
-            (0..m)
-                .map(|j| {
-                    let col = dots.col(j);
-                    let mut best = (f64::INFINITY, 0usize);
-                    for (i, &norm) in norms.iter().enumerate() {
-                        let d = norm - 2.0 * col[i];
-                        if d < best.0 {
-                            best = (d, i);
-                        }
-                    }
-                    best.1 as u32
-                })
-                .collect::<Vec<_>>()
-        })
-        .collect()
 }

@@ -1,0 +1,282 @@
+//! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
+//! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
+
+use super::{SpectralError, Spectrum};
+use faer::linalg::matmul::matmul;
+use faer::{Accum, Mat, MatRef, Par};
+use nalgebra::DMatrix;
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+/// Options of [`zoomout`] (and of the ZoomOut stage of
+/// [`region_point_map`](crate::stable::region_point_map)).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ZoomOutOptions {
+    /// Size `k₀` of the first functional map (default 10).
+    pub initial_size: usize,
+    /// Size of the last functional map (default 150, capped by the eigenpairs available).
+    pub final_size: usize,
+    /// Growth of the map's size per step (default 5).
+    pub step: usize,
+    /// Vertices per shape (farthest-point samples) on which the steps run; the last map is
+    /// evaluated on every vertex (default 2000; at least twice the final size is used).
+    pub samples: usize,
+}
+
+impl Default for ZoomOutOptions {
+    fn default() -> Self {
+        ZoomOutOptions {
+            initial_size: 10,
+            final_size: 150,
+            step: 5,
+            samples: 2000,
+        }
+    }
+}
+
+/// What a spectral map needs of a shape.
+#[derive(Debug, Clone, Copy)]
+pub struct ShapeGeometry<'a> {
+    /// Unit-area spectrum (mass-orthonormal eigenvectors, lumped masses).
+    pub spectrum: &'a Spectrum,
+    /// Vertex positions (only used to spread the samples).
+    pub positions: &'a [[f64; 3]],
+}
+
+/// Refines a point map `T₀` from B to A (`initial[q]` is a vertex of A for every vertex `q`
+/// of B) and returns the refined one, same layout.
+///
+/// The functional map of `T₀` is fitted at size `k₀` (`C = argmin ‖Φ_B C − Φ_A[T₀]‖`, `k₀ × k₀`,
+/// from A's spectral coefficients to B's), then ZoomOut alternates nearest-neighbour point
+/// maps and least-squares functional maps of sizes `k₀ + step, …, final_size` on
+/// farthest-point samples; the last point map is the nearest neighbour of `Φ_B(q)` among the
+/// rows of `Φ_A Cᵀ` over all vertices. Only `T₀`'s low-frequency content matters: a map with
+/// small local errors everywhere is as good a start as an exact one.
+///
+/// Intrinsic: a map that flips a symmetric shape stays flipped. Deterministic whatever the
+/// thread count (fixed blocks; ties go to the lowest index).
+///
+/// ```
+/// use coseg::mesh::TriMesh;
+/// use coseg::spectral::{laplace_beltrami_spectrum, zoomout, ShapeGeometry, SpectrumOptions, ZoomOutOptions};
+/// // A 9 × 3 grid of points.
+/// let (nx, ny) = (9u32, 3u32);
+/// let pos: Vec<[f64; 3]> = (0..nx * ny).map(|i| [(i % nx) as f64, (i / nx) as f64, 0.0]).collect();
+/// let mut faces = Vec::new();
+/// for y in 0..ny - 1 { for x in 0..nx - 1 {
+///     let v = y * nx + x;
+///     faces.push([v, v + 1, v + nx + 1]);
+///     faces.push([v, v + nx + 1, v + nx]);
+/// }}
+/// let mesh = TriMesh::new(pos.clone(), faces).unwrap();
+/// let spectrum = laplace_beltrami_spectrum(&mesh, &SpectrumOptions { eigenpairs: 12, ..Default::default() }).unwrap();
+/// let shape = ShapeGeometry { spectrum: &spectrum, positions: &pos };
+/// // Start from the identity with every vertex of the middle row sent one step to the right.
+/// let start: Vec<u32> = (0..nx * ny).map(|i| if i / nx == 1 && i % nx < nx - 1 { i + 1 } else { i }).collect();
+/// let options = ZoomOutOptions { initial_size: 4, final_size: 12, step: 4, ..Default::default() };
+/// let map = zoomout(shape, shape, &start, &options).unwrap();
+/// assert_eq!(map.len(), start.len());
+/// ```
+pub fn zoomout(
+    a: ShapeGeometry<'_>,
+    b: ShapeGeometry<'_>,
+    initial: &[u32],
+    options: &ZoomOutOptions,
+) -> Result<Vec<u32>, SpectralError> {
+    check_shapes(a, b)?;
+    let d_a = a.spectrum.vertex_count();
+    if initial.len() != b.spectrum.vertex_count() {
+        return Err(SpectralError::InvalidOption(format!(
+            "initial map has {} entries for a shape B of {} vertices",
+            initial.len(),
+            b.spectrum.vertex_count()
+        )));
+    }
+    if let Some(&p) = initial.iter().find(|&&p| p as usize >= d_a) {
+        return Err(SpectralError::InvalidOption(format!(
+            "initial map sends a vertex to {p}, but shape A has {d_a} vertices"
+        )));
+    }
+    let final_size = checked_final_size(a, b, options)?;
+    let k = options.initial_size;
+    let c0 = spectral_fit(
+        eigenvectors(b.spectrum, k),
+        eigenvectors(a.spectrum, k),
+        initial,
+    )?;
+    zoomout_from(a, b, c0, final_size, options)
+}
+
+pub(crate) fn check_shapes(
+    a: ShapeGeometry<'_>,
+    b: ShapeGeometry<'_>,
+) -> Result<(), SpectralError> {
+    for (s, name) in [(a, "A"), (b, "B")] {
+        let d = s.spectrum.vertex_count();
+        if s.positions.len() != d {
+            return Err(SpectralError::InvalidOption(format!(
+                "shape {name}: {} positions for a spectrum of {d} vertices",
+                s.positions.len()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The final size actually used (capped by the eigenpairs of both spectra), after checking
+/// the sizes.
+pub(crate) fn checked_final_size(
+    a: ShapeGeometry<'_>,
+    b: ShapeGeometry<'_>,
+    options: &ZoomOutOptions,
+) -> Result<usize, SpectralError> {
+    let available = a.spectrum.len().min(b.spectrum.len());
+    let final_size = options.final_size.min(available);
+    if options.initial_size == 0 || options.step == 0 || options.initial_size > final_size {
+        return Err(SpectralError::InvalidOption(format!(
+            "map sizes: initial {} and step {} must be positive, and the initial size at \
+             most the final size {final_size} (eigenpairs available: {available})",
+            options.initial_size, options.step
+        )));
+    }
+    Ok(final_size)
+}
+
+/// ZoomOut from a functional map `c0` (`k₀ × k₀`, A's coefficients to B's) up to
+/// `final_size`, then the point map over all vertices.
+pub(crate) fn zoomout_from(
+    a: ShapeGeometry<'_>,
+    b: ShapeGeometry<'_>,
+    c0: DMatrix<f64>,
+    final_size: usize,
+    options: &ZoomOutOptions,
+) -> Result<Vec<u32>, SpectralError> {
+    let phi_a = eigenvectors(a.spectrum, final_size);
+    let phi_b = eigenvectors(b.spectrum, final_size);
+    let samples = options.samples.max(2 * final_size);
+    let samples_a = sample_rows(phi_a, a.positions, samples);
+    let samples_b = sample_rows(phi_b, b.positions, samples);
+    let mut c = c0;
+    let mut k = c.ncols();
+    while k < final_size {
+        let t = nearest_rows(
+            &pulled_back(samples_a.as_ref(), &c),
+            samples_b.subcols(0, k),
+        );
+        let next = (k + options.step).min(final_size);
+        c = spectral_fit(samples_b.subcols(0, next), samples_a.subcols(0, next), &t)?;
+        k = next;
+    }
+    Ok(nearest_rows(&pulled_back(phi_a, &c), phi_b.subcols(0, k)))
+}
+
+/// The first `k` eigenvectors as a `d × k` view.
+pub(crate) fn eigenvectors(s: &Spectrum, k: usize) -> MatRef<'_, f64> {
+    let d = s.vertex_count();
+    MatRef::from_column_major_slice(&s.eigenvectors[..d * k], d, k)
+}
+
+/// `Φ Cᵀ` over the first `C.ncols()` columns of `Φ`: A's spectral embedding expressed in B's
+/// basis, whose rows are compared with B's rows `Φ_B(q)`.
+fn pulled_back(phi: MatRef<'_, f64>, c: &DMatrix<f64>) -> Mat<f64> {
+    let k = c.ncols();
+    let ct = Mat::from_fn(k, c.nrows(), |i, j| c[(j, i)]);
+    let mut out = Mat::zeros(phi.nrows(), c.nrows());
+    matmul(
+        out.as_mut(),
+        Accum::Replace,
+        phi.subcols(0, k),
+        ct.as_ref(),
+        1.0,
+        Par::Seq,
+    );
+    out
+}
+
+/// Least-squares functional map of a point map: `C = argmin ‖Φ_B C − Φ_A[T]‖` (rows of `phi_b`
+/// and entries of `t` correspond).
+fn spectral_fit(
+    phi_b: MatRef<'_, f64>,
+    phi_a: MatRef<'_, f64>,
+    t: &[u32],
+) -> Result<DMatrix<f64>, SpectralError> {
+    let k = phi_b.ncols();
+    let b = DMatrix::from_fn(phi_b.nrows(), k, |i, j| phi_b[(i, j)]);
+    let a = DMatrix::from_fn(t.len(), k, |i, j| phi_a[(t[i] as usize, j)]);
+    let btb = b.transpose() * &b;
+    let bta = b.transpose() * a;
+    btb.cholesky()
+        .map(|ch| ch.solve(&bta))
+        .ok_or_else(|| SpectralError::Solver("ZoomOut: sampled eigenbasis is singular".into()))
+}
+
+/// Rows of `phi` at `count` farthest-point samples of `positions` (all rows when `count ≥ d`),
+/// starting from vertex 0.
+fn sample_rows(phi: MatRef<'_, f64>, positions: &[[f64; 3]], count: usize) -> Mat<f64> {
+    let d = positions.len();
+    let chosen: Vec<usize> = if count >= d {
+        (0..d).collect()
+    } else {
+        let mut dist = vec![f64::INFINITY; d];
+        let mut out = Vec::with_capacity(count);
+        let mut current = 0usize;
+        for _ in 0..count {
+            out.push(current);
+            let c = positions[current];
+            let mut far = (-1.0, 0usize);
+            for (i, p) in positions.iter().enumerate() {
+                let d2 = (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2) + (p[2] - c[2]).powi(2);
+                if d2 < dist[i] {
+                    dist[i] = d2;
+                }
+                if dist[i] > far.0 {
+                    far = (dist[i], i);
+                }
+            }
+            current = far.1;
+        }
+        out
+    };
+    Mat::from_fn(chosen.len(), phi.ncols(), |i, j| phi[(chosen[i], j)])
+}
+
+/// Rows of `query` per block: fixed, so the result does not depend on the thread count.
+const QUERY_BLOCK: usize = 128;
+
+/// For every row of `query`, the index of the nearest row of `base` (Euclidean; ties to the
+/// lowest index). Both have the same number of columns.
+fn nearest_rows(base: &Mat<f64>, query: MatRef<'_, f64>) -> Vec<u32> {
+    let n = base.nrows();
+    let norms: Vec<f64> = (0..n)
+        .map(|i| (0..base.ncols()).map(|j| base[(i, j)] * base[(i, j)]).sum())
+        .collect();
+    let starts: Vec<usize> = (0..query.nrows()).step_by(QUERY_BLOCK).collect();
+    starts
+        .par_iter()
+        .flat_map_iter(|&r0| {
+            let m = QUERY_BLOCK.min(query.nrows() - r0);
+            let mut dots = Mat::<f64>::zeros(n, m);
+            matmul(
+                dots.as_mut(),
+                Accum::Replace,
+                base.as_ref(),
+                query.subrows(r0, m).transpose(),
+                1.0,
+                Par::Seq,
+            );
+            (0..m)
+                .map(|j| {
+                    let col = dots.col(j);
+                    let mut best = (f64::INFINITY, 0usize);
+                    for (i, &norm) in norms.iter().enumerate() {
+                        let d = norm - 2.0 * col[i];
+                        if d < best.0 {
+                            best = (d, i);
+                        }
+                    }
+                    best.1 as u32
+                })
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
