@@ -18,8 +18,8 @@ use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
 use coseg::mesh::read_mesh;
 use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    MapGuidedOptions, RefineOptions, ShapeGeometry, StableRegions, StableRegionsOptions,
-    map_guided_refinement, refine_regions, stable_regions,
+    MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions, ShapeGeometry, StableRegions,
+    StableRegionsOptions, map_guided_refinement, refine_regions, segment_pair, stable_regions,
 };
 use std::path::Path;
 
@@ -61,7 +61,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     )?;
 
     // Last, as `coseg pair` does by default: B's regions re-assigned with a point map read from
-    // a functional map fitted to the region pairs.
+    // a functional map fitted to the region pairs (smoothed more lightly than the refinement).
+    let map_step = MapGuidedOptions::default();
+    let map_smoother_b = HeatSmoother::new(&mesh_b, map_step.smoothing_time)?;
     let mapped = map_guided_refinement(
         &w,
         &refined,
@@ -73,9 +75,25 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             spectrum: &data_b.spectrum,
             positions: mesh_b.positions(),
         },
-        Some(&smoother_b),
-        &MapGuidedOptions::default(),
+        Some(&map_smoother_b),
+        &map_step,
     )?;
+
+    // The same three stages in one call, as `coseg pair` runs them.
+    let one_call = segment_pair(
+        PairShape {
+            mesh: &mesh_a,
+            spectrum: &data_a.spectrum,
+            bands: &data_a.bands,
+        },
+        PairShape {
+            mesh: &mesh_b,
+            spectrum: &data_b.spectrum,
+            bands: &data_b.bands,
+        },
+        &SegmentPairOptions::default(),
+    )?;
+    assert_eq!(one_call.regions, mapped);
 
     println!("region  area on A  area on B  (after refinement and the map step)");
     for (id, pair) in mapped.pairs.iter().enumerate() {

@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example eval_tosca -- /work/shared/data/tosca [--cache DIR]
-//!     [--shapes 4] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
+//!     [--shapes 4] [--seed 0] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
 //!     [--area-bands] [--eigenpairs k] [--hks n] [--wks n] [--curvature n]
 //! ```
 //! For every class, the first `--shapes` files `<class><i>.off` in increasing `i` are taken and
@@ -16,29 +16,56 @@
 
 use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
-use coseg::cache::{ShapePipelineOptions, load_or_compute};
-use coseg::mesh::read_mesh;
+use coseg::cache::{ShapeData, ShapePipelineOptions, load_or_compute};
+use coseg::mesh::{TriMesh, read_mesh};
 use coseg::spectral::{HeatSmoother, ZoomOutOptions, zoomout};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, RefineOptions, ShapeGeometry,
-    StableRegionsOptions, TSearch, VertexMap, correspondence_stats, map_guided_refinement,
-    point_map_refinement, refine_regions, stable_regions,
+    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions,
+    ShapeGeometry, StableRegionsOptions, TSearch, VertexMap, correspondence_stats,
+    point_map_refinement, refine_regions, segment_pair, stable_regions,
 };
 use std::path::PathBuf;
 use std::time::Instant;
 
 /// What runs after the algorithm.
-#[derive(Clone, Copy, PartialEq)]
+#[derive(Clone, Copy)]
 enum Post {
     None,
     /// [`refine_regions`] with default options.
     Refine,
-    /// [`refine_regions`], then [`map_guided_refinement`], default options.
+    /// [`segment_pair`] with default refinement and map step (what `coseg pair` runs).
     RefineMap,
     /// Diagnostic, not a method: [`refine_regions`], then [`point_map_refinement`] with
     /// weight `β` and a ZoomOut map started from the ground truth (what the map step would
     /// give if its map were as good as ZoomOut can make it).
     RefineOracleMap(f64),
+}
+
+/// One shape of a class with its cached data.
+struct Shape {
+    name: String,
+    mesh: TriMesh,
+    areas: Vec<f64>,
+    data: ShapeData,
+    refine_smoother: HeatSmoother,
+    map_smoother: HeatSmoother,
+}
+
+impl Shape {
+    fn pair_shape(&self) -> PairShape<'_> {
+        PairShape {
+            mesh: &self.mesh,
+            spectrum: &self.data.spectrum,
+            bands: &self.data.bands,
+        }
+    }
+
+    fn geometry(&self) -> ShapeGeometry<'_> {
+        ShapeGeometry {
+            spectrum: &self.data.spectrum,
+            positions: self.mesh.positions(),
+        }
+    }
 }
 
 /// `(name, options, post-processing)`.
@@ -153,6 +180,7 @@ fn main() -> anyhow::Result<()> {
     let mut dir = None;
     let mut cache = PathBuf::from("/tmp/coseg-eval-cache");
     let mut shapes = 4usize;
+    let mut seed = 0u64;
     let mut classes = vec![
         "cat".to_string(),
         "dog".into(),
@@ -167,6 +195,10 @@ fn main() -> anyhow::Result<()> {
         match args[i].as_str() {
             "--cache" => {
                 cache = next(i).into();
+                i += 1;
+            }
+            "--seed" => {
+                seed = next(i).parse()?;
                 i += 1;
             }
             "--shapes" => {
@@ -210,6 +242,7 @@ fn main() -> anyhow::Result<()> {
     let configs: Vec<_> = configs()
         .into_iter()
         .filter(|(n, _, _)| which == "all" || which.split(',').any(|w| w == *n))
+        .map(|(n, o, p)| (n, StableRegionsOptions { seed, ..o }, p))
         .collect();
     println!("pipeline: {pipe:?}");
     // Per class: the first `shapes` indices present.
@@ -243,69 +276,71 @@ fn main() -> anyhow::Result<()> {
                 t.elapsed().as_secs_f64(),
                 d.outcome
             );
-            let smoother = HeatSmoother::new(&mesh, RefineOptions::default().smoothing_time)?;
-            data.push((
-                format!("{class}{k}"),
-                mesh.vertex_areas(),
-                d.data.bands,
-                smoother,
-                d.data.spectrum,
-                mesh.positions().to_vec(),
-            ));
+            data.push(Shape {
+                name: format!("{class}{k}"),
+                areas: mesh.vertex_areas(),
+                refine_smoother: HeatSmoother::new(&mesh, RefineOptions::default().smoothing_time)?,
+                map_smoother: HeatSmoother::new(&mesh, MapGuidedOptions::default().smoothing_time)?,
+                mesh,
+                data: d.data,
+            });
         }
         for a in 0..data.len() {
             for b in a + 1..data.len() {
-                let mut line = format!("{:>8} x {:<8}", data[a].0, data[b].0);
+                let (sa, sb) = (&data[a], &data[b]);
+                let mut line = format!("{:>8} x {:<8}", sa.name, sb.name);
                 for (k, (_, opts, post)) in configs.iter().enumerate() {
                     let t = Instant::now();
-                    let mut r =
-                        stable_regions(&data[a].2, &data[b].2, &data[a].1, &data[b].1, opts)?;
-                    let w = BandAffinity::new(&data[a].2, &data[b].2)?;
-                    if *post != Post::None {
-                        r = refine_regions(
+                    let (ba, bb) = (&sa.data.bands, &sb.data.bands);
+                    let w = BandAffinity::new(ba, bb)?;
+                    let r = match post {
+                        Post::None => stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
+                        Post::Refine => refine_regions(
                             &w,
-                            &r,
-                            &data[a].1,
-                            &data[b].1,
-                            Some(&data[a].3),
-                            Some(&data[b].3),
+                            &stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
+                            &sa.areas,
+                            &sb.areas,
+                            Some(&sa.refine_smoother),
+                            Some(&sb.refine_smoother),
                             &RefineOptions::default(),
-                        )?;
-                    }
-                    let (ga, gb) = (
-                        ShapeGeometry {
-                            spectrum: &data[a].4,
-                            positions: &data[a].5,
-                        },
-                        ShapeGeometry {
-                            spectrum: &data[b].4,
-                            positions: &data[b].5,
-                        },
-                    );
-                    if let Post::RefineOracleMap(weight) = *post {
-                        // Within a class the identity is the ground truth.
-                        let truth: Vec<u32> = (0..data[b].1.len() as u32).collect();
-                        let map = zoomout(ga, gb, &truth, &ZoomOutOptions::default())?;
-                        r = point_map_refinement(
-                            &w,
-                            &r,
-                            &map,
-                            &data[a].4.vertex_areas,
-                            &data[b].4.vertex_areas,
-                            Some(&data[b].3),
-                            weight,
-                        )?;
-                    }
-                    if *post == Post::RefineMap {
-                        r = map_guided_refinement(
-                            &w,
-                            &r,
-                            ga,
-                            gb,
-                            Some(&data[b].3),
-                            &MapGuidedOptions::default(),
-                        )?;
-                    }
+                        )?,
+                        // What `coseg pair` runs (its smoothers' set-up is timed too).
+                        Post::RefineMap => {
+                            let options = SegmentPairOptions {
+                                regions: opts.clone(),
+                                ..Default::default()
+                            };
+                            segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions
+                        }
+                        Post::RefineOracleMap(weight) => {
+                            let refined = refine_regions(
+                                &w,
+                                &stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
+                                &sa.areas,
+                                &sb.areas,
+                                Some(&sa.refine_smoother),
+                                Some(&sb.refine_smoother),
+                                &RefineOptions::default(),
+                            )?;
+                            // Within a class the identity is the ground truth.
+                            let truth: Vec<u32> = (0..sb.areas.len() as u32).collect();
+                            let map = zoomout(
+                                sa.geometry(),
+                                sb.geometry(),
+                                &truth,
+                                &ZoomOutOptions::default(),
+                            )?;
+                            point_map_refinement(
+                                &w,
+                                &refined,
+                                &map,
+                                &sa.areas,
+                                &sb.areas,
+                                Some(&sb.map_smoother),
+                                *weight,
+                            )?
+                        }
+                    };
                     times[k] += t.elapsed().as_secs_f64();
                     let st = correspondence_stats(&r, &VertexMap::Identity)?;
                     results[k][ci].push(st.ratio);

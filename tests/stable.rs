@@ -797,11 +797,13 @@ mod map_guided {
     use coseg::affinity::{BandAffinity, Direction};
     use coseg::cache::{ShapeData, ShapePipelineOptions, compute_shape_data};
     use coseg::mesh::TriMesh;
+    use coseg::spectral::HeatSmoother;
     use coseg::spectral::ZoomOutOptions;
     use coseg::stable::{
-        MapGuidedOptions, MapShape, PointMapOptions, RegionPair, ShapeGeometry, StableRegions,
-        assign_regions, map_guided_refinement, point_map_refinement, region_point_map,
-        region_scores,
+        MapGuidedOptions, MapShape, PairShape, PointMapOptions, RefineOptions, RegionPair,
+        SegmentPairOptions, ShapeGeometry, StableRegions, StableRegionsOptions, Threshold,
+        assign_regions, map_guided_refinement, point_map_refinement, refine_regions,
+        region_point_map, region_scores, segment_pair, stable_regions,
     };
 
     fn small_pipeline() -> ShapePipelineOptions {
@@ -987,6 +989,7 @@ mod map_guided {
             let opts = MapGuidedOptions {
                 point_map: options(),
                 map_weight: weight,
+                ..Default::default()
             };
             map_guided_refinement(&w, &regions, ga, gb, None, &opts).unwrap()
         };
@@ -1003,7 +1006,8 @@ mod map_guided {
         let mapped = run(1e6);
         assert_eq!(mapped.labels_b(), carried);
         // The default blend lands on the true partition almost everywhere.
-        let blended = run(1.0);
+        let default_weight = MapGuidedOptions::default().map_weight;
+        let blended = run(default_weight);
         let agree = blended
             .labels_b()
             .iter()
@@ -1041,7 +1045,8 @@ mod map_guided {
         );
         // The same blend with the map handed in.
         let (areas_a, areas_b) = (&da.spectrum.vertex_areas, &db.spectrum.vertex_areas);
-        let handed = point_map_refinement(&w, &regions, &map, areas_a, areas_b, None, 1.0);
+        let handed =
+            point_map_refinement(&w, &regions, &map, areas_a, areas_b, None, default_weight);
         assert_eq!(handed.unwrap(), blended);
         let refine_with = |m: &[u32], weight: f64| {
             point_map_refinement(&w, &regions, m, areas_a, areas_b, None, weight)
@@ -1051,5 +1056,80 @@ mod map_guided {
         outside[3] = la.len() as u32;
         assert!(refine_with(&outside, 1.0).is_err());
         assert!(refine_with(&map, f64::NAN).is_err());
+    }
+
+    fn pair_shape<'a>(mesh: &'a TriMesh, data: &'a ShapeData) -> PairShape<'a> {
+        PairShape {
+            mesh,
+            spectrum: &data.spectrum,
+            bands: &data.bands,
+        }
+    }
+
+    #[test]
+    fn segment_pair_equals_its_stages_run_by_hand() {
+        let (a, b, _, da, db) = permuted_pair();
+        let options = SegmentPairOptions {
+            regions: StableRegionsOptions {
+                pairs: 6,
+                p: Threshold::AreaFraction(1.0 / 6.0),
+                q: Threshold::AreaFraction(1.0 / 6.0),
+                ..Default::default()
+            },
+            refine: Some(RefineOptions::default()),
+            map_guided: Some(MapGuidedOptions {
+                point_map: options(),
+                ..Default::default()
+            }),
+        };
+        let (sa, sb) = (pair_shape(&a, &da), pair_shape(&b, &db));
+        let out = segment_pair(sa, sb, &options).unwrap();
+
+        let (areas_a, areas_b) = (a.vertex_areas(), b.vertex_areas());
+        let raw =
+            stable_regions(&da.bands, &db.bands, &areas_a, &areas_b, &options.regions).unwrap();
+        let w = BandAffinity::new(&da.bands, &db.bands).unwrap();
+        let refine = options.refine.as_ref().unwrap();
+        let smoother = |m: &TriMesh, t: f64| HeatSmoother::new(m, t).unwrap();
+        let refined = refine_regions(
+            &w,
+            &raw,
+            &areas_a,
+            &areas_b,
+            Some(&smoother(&a, refine.smoothing_time)),
+            Some(&smoother(&b, refine.smoothing_time)),
+            refine,
+        )
+        .unwrap();
+        let map_guided = options.map_guided.as_ref().unwrap();
+        let by_hand = map_guided_refinement(
+            &w,
+            &refined,
+            ShapeGeometry {
+                spectrum: &da.spectrum,
+                positions: a.positions(),
+            },
+            ShapeGeometry {
+                spectrum: &db.spectrum,
+                positions: b.positions(),
+            },
+            Some(&smoother(&b, map_guided.smoothing_time)),
+            map_guided,
+        )
+        .unwrap();
+        assert_eq!(out.regions, by_hand);
+        assert_ne!(refined, raw, "the fixture should exercise the refinement");
+
+        let bare = SegmentPairOptions {
+            refine: None,
+            map_guided: None,
+            ..options.clone()
+        };
+        let out = segment_pair(sa, sb, &bare).unwrap();
+        assert_eq!(out.regions, raw);
+
+        let other = blob(2);
+        let mismatched = PairShape { mesh: &other, ..sb };
+        assert!(segment_pair(sa, mismatched, &options).is_err());
     }
 }

@@ -2,15 +2,14 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::affinity::BandAffinity;
 use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
 use coseg::mesh::read_mesh_with_report;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
-use coseg::spectral::{HeatSmoother, ZoomOutOptions};
+use coseg::spectral::ZoomOutOptions;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, PointMapOptions, RefineOptions,
-    ShapeGeometry, StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio,
-    map_guided_refinement, refine_regions, stable_regions,
+    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, PointMapOptions, RefineOptions,
+    SegmentPairOptions, StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio,
+    segment_pair,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -90,6 +89,9 @@ pub struct PairArgs {
     /// Size of the last functional map of that step (capped by the eigenpairs computed).
     #[arg(long, default_value_t = ZoomOutOptions::default().final_size)]
     map_size: usize,
+    /// Heat-smoothing time of that step's blended scores (0 = no smoothing).
+    #[arg(long, default_value_t = MapGuidedOptions::default().smoothing_time)]
+    map_smoothing_time: f64,
     /// Ground truth for the correspondence ratio: `identity`, or a file with one B index per
     /// vertex of A (negative = none).
     #[arg(long)]
@@ -159,9 +161,6 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     };
     let (ma, da) = &loaded[0];
     let (mb, db) = &loaded[1];
-    let t = Instant::now();
-    let (areas_a, areas_b) = (ma.vertex_areas(), mb.vertex_areas());
-    let mut regions = stable_regions(&da.bands, &db.bands, &areas_a, &areas_b, &options)?;
     let refine = (args.refine_rounds > 0).then_some(RefineOptions {
         max_rounds: args.refine_rounds,
         smoothing_time: args.smoothing_time,
@@ -175,45 +174,28 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             ..Default::default()
         },
         map_weight: args.map_weight,
+        smoothing_time: args.map_smoothing_time,
     });
-    let smoothing_time = args.smoothing_time;
-    let smoothers = if (refine.is_some() || map_guided.is_some()) && smoothing_time > 0.0 {
-        let sa = HeatSmoother::new(ma, smoothing_time)
-            .with_context(|| format!("smoothing on {}", args.a.display()))?;
-        let sb = HeatSmoother::new(mb, smoothing_time)
-            .with_context(|| format!("smoothing on {}", args.b.display()))?;
-        Some((sa, sb))
-    } else {
-        None
+    let pair_options = SegmentPairOptions {
+        regions: options,
+        refine,
+        map_guided,
     };
-    let w = BandAffinity::new(&da.bands, &db.bands)?;
-    if let Some(refine) = &refine {
-        regions = refine_regions(
-            &w,
-            &regions,
-            &areas_a,
-            &areas_b,
-            smoothers.as_ref().map(|s| &s.0),
-            smoothers.as_ref().map(|s| &s.1),
-            refine,
-        )?;
-    }
-    if let Some(options) = &map_guided {
-        regions = map_guided_refinement(
-            &w,
-            &regions,
-            ShapeGeometry {
-                spectrum: &da.spectrum,
-                positions: ma.positions(),
-            },
-            ShapeGeometry {
-                spectrum: &db.spectrum,
-                positions: mb.positions(),
-            },
-            smoothers.as_ref().map(|s| &s.1),
-            options,
-        )?;
-    }
+    let t = Instant::now();
+    let regions = segment_pair(
+        PairShape {
+            mesh: ma,
+            spectrum: &da.spectrum,
+            bands: &da.bands,
+        },
+        PairShape {
+            mesh: mb,
+            spectrum: &db.spectrum,
+            bands: &db.bands,
+        },
+        &pair_options,
+    )?
+    .regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
@@ -241,12 +223,12 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             },
         ],
         &regions,
-        &options,
+        &pair_options.regions,
         ratio,
         seconds,
     )
-    .with_refine(refine)
-    .with_map_guided(map_guided);
+    .with_refine(pair_options.refine)
+    .with_map_guided(pair_options.map_guided);
     let shapes = [
         ShapeRegions {
             name: &na,

@@ -11,6 +11,7 @@
 //! - [`region_point_map`]: a vertex map from corresponding regions (functional map + ZoomOut).
 //! - [`map_guided_refinement`]: B's regions re-assigned by band affinity and that map
 //!   ([`point_map_refinement`]: the same with a map of your own).
+//! - [`segment_pair`]: the whole pair stage in one call (algorithm → refinement → map step).
 //! - [`correspondence_ratio`]: quality against a ground-truth map (paper §7.2).
 
 mod correspondence_ratio;
@@ -19,6 +20,7 @@ mod map_guided_refinement;
 mod refine_partition;
 mod refine_regions;
 mod region_point_map;
+mod segment_pair;
 mod stable_pair;
 mod stable_pairs_auto;
 mod stable_pairs_fixed;
@@ -36,6 +38,7 @@ pub use refine_partition::{
 };
 pub use refine_regions::refine_regions;
 pub use region_point_map::{MapShape, PointMapOptions, region_point_map};
+pub use segment_pair::{PairShape, PairTimes, SegmentPairOptions, SegmentedPair, segment_pair};
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
 };
