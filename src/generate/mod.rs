@@ -27,7 +27,7 @@ mod write_collection;
 
 pub use generate_family::{GenerateOptions, generate_family};
 pub use marching_tetrahedra::{ScalarGrid, marching_tetrahedra};
-pub use write_collection::{Manifest, ManifestShape, obj_text, write_collection};
+pub use write_collection::{MANIFEST_FORMAT, Manifest, ManifestShape, obj_text, write_collection};
 
 use crate::mesh::TriMesh;
 use thiserror::Error;
