@@ -70,10 +70,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         ShapeGeometry {
             spectrum: &data_a.spectrum,
             positions: mesh_a.positions(),
+            descriptors: Some(&data_a.descriptors.values),
         },
         ShapeGeometry {
             spectrum: &data_b.spectrum,
             positions: mesh_b.positions(),
+            descriptors: Some(&data_b.descriptors.values),
         },
         Some(&map_smoother_b),
         &map_step,
@@ -85,11 +87,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             mesh: &mesh_a,
             spectrum: &data_a.spectrum,
             bands: &data_a.bands,
+            descriptors: Some(&data_a.descriptors.values),
         },
         PairShape {
             mesh: &mesh_b,
             spectrum: &data_b.spectrum,
             bands: &data_b.bands,
+            descriptors: Some(&data_b.descriptors.values),
         },
         &SegmentPairOptions::default(),
     )?;

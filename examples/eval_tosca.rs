@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! cargo run --release --example eval_tosca -- /work/shared/data/tosca [--cache DIR]
-//!     [--shapes 4] [--seed 0] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
+//!     [--shapes 4] [--seed 0] [--map-weight β] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
 //!     [--area-bands] [--eigenpairs k] [--hks n] [--wks n] [--curvature n]
 //! ```
 //! For every class, the first `--shapes` files `<class><i>.off` in increasing `i` are taken and
@@ -35,6 +35,8 @@ enum Post {
     Refine,
     /// [`segment_pair`] with default refinement and map step (what `coseg pair` runs).
     RefineMap,
+    /// The same with [`MapGuidedOptions::near_isometric`] (`coseg pair --near-isometric`).
+    RefineMapIsometric,
     /// Diagnostic, not a method: [`refine_regions`], then [`point_map_refinement`] with
     /// weight `β` and a ZoomOut map started from the ground truth (what the map step would
     /// give if its map were as good as ZoomOut can make it).
@@ -57,6 +59,7 @@ impl Shape {
             mesh: &self.mesh,
             spectrum: &self.data.spectrum,
             bands: &self.data.bands,
+            descriptors: Some(&self.data.descriptors.values),
         }
     }
 
@@ -64,6 +67,7 @@ impl Shape {
         ShapeGeometry {
             spectrum: &self.data.spectrum,
             positions: self.mesh.positions(),
+            descriptors: Some(&self.data.descriptors.values),
         }
     }
 }
@@ -149,6 +153,22 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, Post)> {
             Post::RefineMap,
         ),
         (
+            "alg2-random-mapped-iso",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..base.clone()
+            },
+            Post::RefineMapIsometric,
+        ),
+        (
+            "alg3-random-mapped-iso",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..auto.clone()
+            },
+            Post::RefineMapIsometric,
+        ),
+        (
             "alg2-random-oracle-map",
             StableRegionsOptions {
                 init: Init::Random,
@@ -181,6 +201,7 @@ fn main() -> anyhow::Result<()> {
     let mut cache = PathBuf::from("/tmp/coseg-eval-cache");
     let mut shapes = 4usize;
     let mut seed = 0u64;
+    let mut map_step = MapGuidedOptions::default();
     let mut classes = vec![
         "cat".to_string(),
         "dog".into(),
@@ -195,6 +216,10 @@ fn main() -> anyhow::Result<()> {
         match args[i].as_str() {
             "--cache" => {
                 cache = next(i).into();
+                i += 1;
+            }
+            "--map-weight" => {
+                map_step.map_weight = next(i).parse()?;
                 i += 1;
             }
             "--seed" => {
@@ -308,6 +333,15 @@ fn main() -> anyhow::Result<()> {
                         Post::RefineMap => {
                             let options = SegmentPairOptions {
                                 regions: opts.clone(),
+                                map_guided: Some(map_step.clone()),
+                                ..Default::default()
+                            };
+                            segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions
+                        }
+                        Post::RefineMapIsometric => {
+                            let options = SegmentPairOptions {
+                                regions: opts.clone(),
+                                map_guided: Some(MapGuidedOptions::near_isometric()),
                                 ..Default::default()
                             };
                             segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions

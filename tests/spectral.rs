@@ -452,6 +452,7 @@ mod zoomout_map {
             final_size: 40,
             step: 5,
             samples: 300,
+            ..Default::default()
         }
     }
 
@@ -514,10 +515,12 @@ mod zoomout_map {
             ShapeGeometry {
                 spectrum: &sa,
                 positions: a.positions(),
+                descriptors: None,
             },
             ShapeGeometry {
                 spectrum: &sb,
                 positions: b.positions(),
+                descriptors: None,
             },
             &start,
             &options(),
@@ -547,10 +550,12 @@ mod zoomout_map {
         let ga = ShapeGeometry {
             spectrum: &sa,
             positions: a.positions(),
+            descriptors: None,
         };
         let gb = ShapeGeometry {
             spectrum: &sb,
             positions: b.positions(),
+            descriptors: None,
         };
         let truth: Vec<u32> = perm.iter().map(|&o| o as u32).collect();
         let first = zoomout(ga, gb, &truth, &options()).unwrap();
@@ -575,5 +580,72 @@ mod zoomout_map {
             ..gb
         };
         assert!(zoomout(ga, short, &truth, &options()).is_err());
+    }
+}
+
+mod zoomout_descriptors {
+    use super::common::features::{blob, permutation, permute_mesh};
+    use coseg::spectral::{
+        ShapeGeometry, SpectrumOptions, ZoomOutOptions, laplace_beltrami_spectrum, zoomout,
+    };
+
+    /// Coordinates as three feature-major descriptor columns: on a vertex-permuted copy they
+    /// identify every vertex exactly.
+    fn coordinates(pos: &[[f64; 3]]) -> Vec<f64> {
+        (0..3).flat_map(|c| pos.iter().map(move |p| p[c])).collect()
+    }
+
+    #[test]
+    fn zoomout_descriptors_decide_the_last_match() {
+        let a = blob(3);
+        let perm = permutation(a.vertex_count(), 5);
+        let b = permute_mesh(&a, &perm);
+        let opts = SpectrumOptions::with_eigenpairs(40);
+        let (sa, sb) = (
+            laplace_beltrami_spectrum(&a, &opts).unwrap(),
+            laplace_beltrami_spectrum(&b, &opts).unwrap(),
+        );
+        let (da, db) = (coordinates(a.positions()), coordinates(b.positions()));
+        let ga = ShapeGeometry {
+            spectrum: &sa,
+            positions: a.positions(),
+            descriptors: Some(&da),
+        };
+        let gb = ShapeGeometry {
+            spectrum: &sb,
+            positions: b.positions(),
+            descriptors: Some(&db),
+        };
+        let truth: Vec<u32> = perm.iter().map(|&o| o as u32).collect();
+        let run = |weight: f64| {
+            let options = ZoomOutOptions {
+                initial_size: 6,
+                final_size: 40,
+                step: 5,
+                samples: 300,
+                descriptor_weight: weight,
+            };
+            zoomout(ga, gb, &truth, &options)
+        };
+        let exact = |map: &[u32]| map.iter().zip(&truth).filter(|(x, y)| x == y).count();
+        let spectral_only = run(0.0).unwrap();
+        let with_descriptors = run(1e6).unwrap();
+        assert!(
+            exact(&spectral_only) < truth.len(),
+            "the fixture should not be trivial"
+        );
+        assert_eq!(with_descriptors, truth);
+        assert!(run(-1.0).is_err());
+        assert!(run(f64::NAN).is_err());
+        let ragged = ShapeGeometry {
+            descriptors: Some(&db[1..]),
+            ..gb
+        };
+        assert!(zoomout(ga, ragged, &truth, &ZoomOutOptions::default()).is_err());
+        let fewer = ShapeGeometry {
+            descriptors: Some(&db[..2 * b.vertex_count()]),
+            ..gb
+        };
+        assert!(zoomout(ga, fewer, &truth, &ZoomOutOptions::default()).is_err());
     }
 }

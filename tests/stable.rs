@@ -817,6 +817,7 @@ mod map_guided {
                 final_size: 40,
                 step: 5,
                 samples: 300,
+                ..Default::default()
             },
             ..Default::default()
         }
@@ -849,11 +850,13 @@ mod map_guided {
                 spectrum: &da.spectrum,
                 positions: a.positions(),
                 labels: la,
+                descriptors: None,
             },
             &MapShape {
                 spectrum: &db.spectrum,
                 positions: b.positions(),
                 labels: lb,
+                descriptors: None,
             },
             &options(),
         )
@@ -938,6 +941,7 @@ mod map_guided {
             spectrum: &da.spectrum,
             positions: a.positions(),
             labels: &la,
+            descriptors: None,
         };
         let first = region_point_map(&shape, &shape, &options()).unwrap();
         let pool = rayon::ThreadPoolBuilder::new()
@@ -979,10 +983,12 @@ mod map_guided {
             ShapeGeometry {
                 spectrum: &da.spectrum,
                 positions: a.positions(),
+                descriptors: None,
             },
             ShapeGeometry {
                 spectrum: &db.spectrum,
                 positions: b.positions(),
+                descriptors: None,
             },
         );
         let run = |weight: f64| {
@@ -1063,6 +1069,7 @@ mod map_guided {
             mesh,
             spectrum: &data.spectrum,
             bands: &data.bands,
+            descriptors: None,
         }
     }
 
@@ -1108,10 +1115,12 @@ mod map_guided {
             ShapeGeometry {
                 spectrum: &da.spectrum,
                 positions: a.positions(),
+                descriptors: None,
             },
             ShapeGeometry {
                 spectrum: &db.spectrum,
                 positions: b.positions(),
+                descriptors: None,
             },
             Some(&smoother(&b, map_guided.smoothing_time)),
             map_guided,

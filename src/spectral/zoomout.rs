@@ -21,6 +21,13 @@ pub struct ZoomOutOptions {
     /// Vertices per shape (farthest-point samples) on which the steps run; the last map is
     /// evaluated on every vertex (default 2000; at least twice the final size is used).
     pub samples: usize,
+    /// Weight `λ` of the descriptors in the last nearest-neighbour search, when both shapes
+    /// carry them: the rows compared are `[Φ_A Cᵀ | λ D_A]` and `[Φ_B | λ D_B]`, each
+    /// descriptor column scaled to unit Euclidean norm over its shape's vertices (default 0:
+    /// plain ZoomOut). About 500 makes the descriptors weigh as much as the spectral
+    /// coordinates; on near-isometric pairs they pin the map where the spectral embedding
+    /// drifts (see [`MapGuidedOptions::near_isometric`](crate::stable::MapGuidedOptions)).
+    pub descriptor_weight: f64,
 }
 
 impl Default for ZoomOutOptions {
@@ -30,6 +37,7 @@ impl Default for ZoomOutOptions {
             final_size: 150,
             step: 5,
             samples: 2000,
+            descriptor_weight: 0.0,
         }
     }
 }
@@ -41,6 +49,10 @@ pub struct ShapeGeometry<'a> {
     pub spectrum: &'a Spectrum,
     /// Vertex positions (only used to spread the samples).
     pub positions: &'a [[f64; 3]],
+    /// Optional per-vertex descriptors, feature-major `N × d` (feature `f` of vertex `v` at
+    /// `f·d + v`, the layout of [`Descriptors::values`](crate::features::Descriptors)); used
+    /// by the last nearest-neighbour search when both shapes have the same `N`.
+    pub descriptors: Option<&'a [f64]>,
 }
 
 /// Refines a point map `T₀` from B to A (`initial[q]` is a vertex of A for every vertex `q`
@@ -70,7 +82,7 @@ pub struct ShapeGeometry<'a> {
 /// }}
 /// let mesh = TriMesh::new(pos.clone(), faces).unwrap();
 /// let spectrum = laplace_beltrami_spectrum(&mesh, &SpectrumOptions { eigenpairs: 12, ..Default::default() }).unwrap();
-/// let shape = ShapeGeometry { spectrum: &spectrum, positions: &pos };
+/// let shape = ShapeGeometry { spectrum: &spectrum, positions: &pos, descriptors: None };
 /// // Start from the identity with every vertex of the middle row sent one step to the right.
 /// let start: Vec<u32> = (0..nx * ny).map(|i| if i / nx == 1 && i % nx < nx - 1 { i + 1 } else { i }).collect();
 /// let options = ZoomOutOptions { initial_size: 4, final_size: 12, step: 4, ..Default::default() };
@@ -84,6 +96,7 @@ pub fn zoomout(
     options: &ZoomOutOptions,
 ) -> Result<Vec<u32>, SpectralError> {
     check_shapes(a, b)?;
+    check_weight(options)?;
     let d_a = a.spectrum.vertex_count();
     if initial.len() != b.spectrum.vertex_count() {
         return Err(SpectralError::InvalidOption(format!(
@@ -119,8 +132,41 @@ pub(crate) fn check_shapes(
                 s.positions.len()
             )));
         }
+        if let Some(x) = s.descriptors
+            && (d == 0 || !x.len().is_multiple_of(d))
+        {
+            return Err(SpectralError::InvalidOption(format!(
+                "shape {name}: {} descriptor values are not a whole number of columns of {d}",
+                x.len()
+            )));
+        }
+    }
+    if !(options_ok(a, b)) {
+        return Err(SpectralError::InvalidOption(
+            "the two shapes carry different numbers of descriptors".into(),
+        ));
     }
     Ok(())
+}
+
+fn options_ok(a: ShapeGeometry<'_>, b: ShapeGeometry<'_>) -> bool {
+    match (a.descriptors, b.descriptors) {
+        (Some(x), Some(y)) => {
+            x.len() / a.spectrum.vertex_count().max(1) == y.len() / b.spectrum.vertex_count().max(1)
+        }
+        _ => true,
+    }
+}
+
+pub(crate) fn check_weight(options: &ZoomOutOptions) -> Result<(), SpectralError> {
+    if options.descriptor_weight.is_finite() && options.descriptor_weight >= 0.0 {
+        Ok(())
+    } else {
+        Err(SpectralError::InvalidOption(format!(
+            "descriptor_weight = {} must be finite and non-negative",
+            options.descriptor_weight
+        )))
+    }
 }
 
 /// The final size actually used (capped by the eigenpairs of both spectra), after checking
@@ -167,7 +213,37 @@ pub(crate) fn zoomout_from(
         c = spectral_fit(samples_b.subcols(0, next), samples_a.subcols(0, next), &t)?;
         k = next;
     }
-    Ok(nearest_rows(&pulled_back(phi_a, &c), phi_b.subcols(0, k)))
+    let base = pulled_back(phi_a, &c);
+    let lambda = options.descriptor_weight;
+    match (a.descriptors, b.descriptors) {
+        (Some(da), Some(db)) if lambda > 0.0 => {
+            let base = with_descriptors(base.as_ref(), da, lambda);
+            let query = with_descriptors(phi_b.subcols(0, k), db, lambda);
+            Ok(nearest_rows(&base, query.as_ref()))
+        }
+        _ => Ok(nearest_rows(&base, phi_b.subcols(0, k))),
+    }
+}
+
+/// `[x | λ D̂]`: `x` (`d × k`) with the descriptors appended as columns, each scaled to unit
+/// Euclidean norm and then by `λ`.
+fn with_descriptors(x: MatRef<'_, f64>, descriptors: &[f64], lambda: f64) -> Mat<f64> {
+    let (d, k) = (x.nrows(), x.ncols());
+    let n = descriptors.len() / d;
+    let scales: Vec<f64> = descriptors
+        .chunks_exact(d)
+        .map(|col| {
+            let norm = col.iter().map(|v| v * v).sum::<f64>().sqrt();
+            if norm > 0.0 { lambda / norm } else { 0.0 }
+        })
+        .collect();
+    Mat::from_fn(d, k + n, |i, j| {
+        if j < k {
+            x[(i, j)]
+        } else {
+            scales[j - k] * descriptors[(j - k) * d + i]
+        }
+    })
 }
 
 /// The first `k` eigenvectors as a `d × k` view.

@@ -3,7 +3,9 @@
 //! spectrally (ZoomOut).
 
 use super::StableError;
-use crate::spectral::zoomout::{check_shapes, checked_final_size, eigenvectors, zoomout_from};
+use crate::spectral::zoomout::{
+    check_shapes, check_weight, checked_final_size, eigenvectors, zoomout_from,
+};
 use crate::spectral::{ShapeGeometry, Spectrum, ZoomOutOptions};
 use faer::MatRef;
 use nalgebra::{DMatrix, DVector};
@@ -39,6 +41,9 @@ pub struct MapShape<'a> {
     pub positions: &'a [[f64; 3]],
     /// Region id of every vertex (`-1`: none); region `r` of A corresponds to region `r` of B.
     pub labels: &'a [i32],
+    /// Optional per-vertex descriptors (see [`ShapeGeometry::descriptors`]), used by the last
+    /// nearest-neighbour search.
+    pub descriptors: Option<&'a [f64]>,
 }
 
 /// For every vertex `q` of B, a vertex `T(q)` of A, from corresponding regions.
@@ -71,7 +76,7 @@ pub struct MapShape<'a> {
 /// let mesh = TriMesh::new(pos.clone(), faces).unwrap();
 /// let spectrum = laplace_beltrami_spectrum(&mesh, &SpectrumOptions { eigenpairs: 12, ..Default::default() }).unwrap();
 /// let labels: Vec<i32> = (0..nx * ny).map(|i| i32::from(i % nx >= 4)).collect();
-/// let shape = MapShape { spectrum: &spectrum, positions: &pos, labels: &labels };
+/// let shape = MapShape { spectrum: &spectrum, positions: &pos, labels: &labels, descriptors: None };
 /// let zoomout = ZoomOutOptions { initial_size: 4, final_size: 12, step: 4, ..Default::default() };
 /// let options = PointMapOptions { zoomout, ..Default::default() };
 /// let map = region_point_map(&shape, &shape, &options).unwrap();
@@ -85,6 +90,7 @@ pub fn region_point_map(
 ) -> Result<Vec<u32>, StableError> {
     let (ga, gb) = (a.geometry(), b.geometry());
     check_shapes(ga, gb)?;
+    check_weight(&options.zoomout)?;
     for (s, name) in [(a, "A"), (b, "B")] {
         let d = s.spectrum.vertex_count();
         if s.labels.len() != d {
@@ -117,6 +123,7 @@ impl MapShape<'_> {
         ShapeGeometry {
             spectrum: self.spectrum,
             positions: self.positions,
+            descriptors: self.descriptors,
         }
     }
 }

@@ -47,6 +47,9 @@ pub struct PairShape<'a> {
     pub spectrum: &'a Spectrum,
     /// Its `d × N` band table.
     pub bands: &'a BandTable,
+    /// Its descriptors, feature-major (`Descriptors::values`); optional, they sharpen the map
+    /// step's point map (see [`ZoomOutOptions::descriptor_weight`](crate::spectral::ZoomOutOptions)).
+    pub descriptors: Option<&'a [f64]>,
 }
 
 impl<'a> PairShape<'a> {
@@ -54,6 +57,7 @@ impl<'a> PairShape<'a> {
         ShapeGeometry {
             spectrum: self.spectrum,
             positions: self.mesh.positions(),
+            descriptors: self.descriptors,
         }
     }
 }
@@ -94,8 +98,8 @@ pub struct SegmentedPair {
 /// let (ma, mb) = (read_mesh("cat0.off")?, read_mesh("cat1.off")?);
 /// let pipe = ShapePipelineOptions::default();
 /// let (da, db) = (compute_shape_data(&ma, &pipe)?, compute_shape_data(&mb, &pipe)?);
-/// let a = PairShape { mesh: &ma, spectrum: &da.spectrum, bands: &da.bands };
-/// let b = PairShape { mesh: &mb, spectrum: &db.spectrum, bands: &db.bands };
+/// let a = PairShape { mesh: &ma, spectrum: &da.spectrum, bands: &da.bands, descriptors: None };
+/// let b = PairShape { mesh: &mb, spectrum: &db.spectrum, bands: &db.bands, descriptors: None };
 /// let out = segment_pair(a, b, &SegmentPairOptions::default())?;
 /// println!("{} region pairs in {:?}", out.regions.pairs.len(), out.times.algorithm);
 /// # Ok(()) }
