@@ -95,8 +95,7 @@ pub fn zoomout(
     initial: &[u32],
     options: &ZoomOutOptions,
 ) -> Result<Vec<u32>, SpectralError> {
-    check_shapes(a, b)?;
-    check_weight(options)?;
+    let final_size = validate(a, b, options)?;
     let d_a = a.spectrum.vertex_count();
     if initial.len() != b.spectrum.vertex_count() {
         return Err(SpectralError::InvalidOption(format!(
@@ -110,7 +109,6 @@ pub fn zoomout(
             "initial map sends a vertex to {p}, but shape A has {d_a} vertices"
         )));
     }
-    let final_size = checked_final_size(a, b, options)?;
     let k = options.initial_size;
     let c0 = spectral_fit(
         eigenvectors(b.spectrum, k),
@@ -120,10 +118,14 @@ pub fn zoomout(
     zoomout_from(a, b, c0, final_size, options)
 }
 
-pub(crate) fn check_shapes(
+/// Checks both shapes and the options; returns the final size actually used (capped by the
+/// eigenpairs of both spectra).
+pub(crate) fn validate(
     a: ShapeGeometry<'_>,
     b: ShapeGeometry<'_>,
-) -> Result<(), SpectralError> {
+    options: &ZoomOutOptions,
+) -> Result<usize, SpectralError> {
+    let mut descriptor_columns = Vec::new();
     for (s, name) in [(a, "A"), (b, "B")] {
         let d = s.spectrum.vertex_count();
         if s.positions.len() != d {
@@ -132,50 +134,28 @@ pub(crate) fn check_shapes(
                 s.positions.len()
             )));
         }
-        if let Some(x) = s.descriptors
-            && (d == 0 || !x.len().is_multiple_of(d))
-        {
-            return Err(SpectralError::InvalidOption(format!(
-                "shape {name}: {} descriptor values are not a whole number of columns of {d}",
-                x.len()
-            )));
+        if let Some(x) = s.descriptors {
+            if d == 0 || !x.len().is_multiple_of(d) {
+                return Err(SpectralError::InvalidOption(format!(
+                    "shape {name}: {} descriptor values are not a whole number of columns of {d}",
+                    x.len()
+                )));
+            }
+            descriptor_columns.push(x.len() / d);
         }
     }
-    if !(options_ok(a, b)) {
-        return Err(SpectralError::InvalidOption(
-            "the two shapes carry different numbers of descriptors".into(),
-        ));
+    if descriptor_columns.len() == 2 && descriptor_columns[0] != descriptor_columns[1] {
+        return Err(SpectralError::InvalidOption(format!(
+            "the shapes carry {} and {} descriptors",
+            descriptor_columns[0], descriptor_columns[1]
+        )));
     }
-    Ok(())
-}
-
-fn options_ok(a: ShapeGeometry<'_>, b: ShapeGeometry<'_>) -> bool {
-    match (a.descriptors, b.descriptors) {
-        (Some(x), Some(y)) => {
-            x.len() / a.spectrum.vertex_count().max(1) == y.len() / b.spectrum.vertex_count().max(1)
-        }
-        _ => true,
-    }
-}
-
-pub(crate) fn check_weight(options: &ZoomOutOptions) -> Result<(), SpectralError> {
-    if options.descriptor_weight.is_finite() && options.descriptor_weight >= 0.0 {
-        Ok(())
-    } else {
-        Err(SpectralError::InvalidOption(format!(
+    if !(options.descriptor_weight.is_finite() && options.descriptor_weight >= 0.0) {
+        return Err(SpectralError::InvalidOption(format!(
             "descriptor_weight = {} must be finite and non-negative",
             options.descriptor_weight
-        )))
+        )));
     }
-}
-
-/// The final size actually used (capped by the eigenpairs of both spectra), after checking
-/// the sizes.
-pub(crate) fn checked_final_size(
-    a: ShapeGeometry<'_>,
-    b: ShapeGeometry<'_>,
-    options: &ZoomOutOptions,
-) -> Result<usize, SpectralError> {
     let available = a.spectrum.len().min(b.spectrum.len());
     let final_size = options.final_size.min(available);
     if options.initial_size == 0 || options.step == 0 || options.initial_size > final_size {

@@ -3,9 +3,7 @@
 //! spectrally (ZoomOut).
 
 use super::StableError;
-use crate::spectral::zoomout::{
-    check_shapes, check_weight, checked_final_size, eigenvectors, zoomout_from,
-};
+use crate::spectral::zoomout::{eigenvectors, validate, zoomout_from};
 use crate::spectral::{ShapeGeometry, Spectrum, ZoomOutOptions};
 use faer::MatRef;
 use nalgebra::{DMatrix, DVector};
@@ -89,8 +87,7 @@ pub fn region_point_map(
     options: &PointMapOptions,
 ) -> Result<Vec<u32>, StableError> {
     let (ga, gb) = (a.geometry(), b.geometry());
-    check_shapes(ga, gb)?;
-    check_weight(&options.zoomout)?;
+    let final_size = validate(ga, gb, &options.zoomout)?;
     for (s, name) in [(a, "A"), (b, "B")] {
         let d = s.spectrum.vertex_count();
         if s.labels.len() != d {
@@ -100,7 +97,6 @@ pub fn region_point_map(
             )));
         }
     }
-    let final_size = checked_final_size(ga, gb, &options.zoomout)?;
     if !(options.commutativity.is_finite() && options.commutativity >= 0.0) {
         return Err(StableError::BadOption(format!(
             "commutativity = {} must be finite and non-negative",
