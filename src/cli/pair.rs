@@ -208,7 +208,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             descriptors: Some(&db.descriptors.values),
         },
         &pair_options,
-    )?
+    )
+    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?
     .regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
