@@ -318,9 +318,8 @@ fn main() -> anyhow::Result<()> {
                     let t = Instant::now();
                     let (ba, bb) = (&sa.data.bands, &sb.data.bands);
                     let w = BandAffinity::new(ba, bb)?;
-                    let r = match post {
-                        Post::None => stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
-                        Post::Refine => refine_regions(
+                    let refined = || -> anyhow::Result<_> {
+                        Ok(refine_regions(
                             &w,
                             &stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
                             &sa.areas,
@@ -328,34 +327,26 @@ fn main() -> anyhow::Result<()> {
                             Some(&sa.refine_smoother),
                             Some(&sb.refine_smoother),
                             &RefineOptions::default(),
-                        )?,
-                        // What `coseg pair` runs (its smoothers' set-up is timed too).
-                        Post::RefineMap => {
-                            let options = SegmentPairOptions {
-                                regions: opts.clone(),
-                                map_guided: Some(map_step.clone()),
-                                ..Default::default()
-                            };
-                            segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions
-                        }
+                        )?)
+                    };
+                    // What `coseg pair` runs (its smoothers' set-up is timed too).
+                    let whole_stage = |map_guided: MapGuidedOptions| -> anyhow::Result<_> {
+                        let options = SegmentPairOptions {
+                            regions: opts.clone(),
+                            map_guided: Some(map_guided),
+                            ..Default::default()
+                        };
+                        Ok(segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions)
+                    };
+                    let r = match post {
+                        Post::None => stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
+                        Post::Refine => refined()?,
+                        Post::RefineMap => whole_stage(map_step.clone())?,
                         Post::RefineMapIsometric => {
-                            let options = SegmentPairOptions {
-                                regions: opts.clone(),
-                                map_guided: Some(MapGuidedOptions::near_isometric()),
-                                ..Default::default()
-                            };
-                            segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions
+                            whole_stage(MapGuidedOptions::near_isometric())?
                         }
                         Post::RefineOracleMap(weight) => {
-                            let refined = refine_regions(
-                                &w,
-                                &stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
-                                &sa.areas,
-                                &sb.areas,
-                                Some(&sa.refine_smoother),
-                                Some(&sb.refine_smoother),
-                                &RefineOptions::default(),
-                            )?;
+                            let refined = refined()?;
                             // Within a class the identity is the ground truth.
                             let truth: Vec<u32> = (0..sb.areas.len() as u32).collect();
                             let map = zoomout(
