@@ -979,18 +979,7 @@ mod map_guided {
             .collect();
         let regions = regions_of(&la, &lb);
         let w = BandAffinity::new(&da.bands, &db.bands).unwrap();
-        let (ga, gb) = (
-            ShapeGeometry {
-                spectrum: &da.spectrum,
-                positions: a.positions(),
-                descriptors: None,
-            },
-            ShapeGeometry {
-                spectrum: &db.spectrum,
-                positions: b.positions(),
-                descriptors: None,
-            },
-        );
+        let (ga, gb) = (geometry(&a, &da), geometry(&b, &db));
         let run = |weight: f64| {
             let opts = MapGuidedOptions {
                 point_map: options(),
@@ -1064,6 +1053,15 @@ mod map_guided {
         assert!(refine_with(&map, f64::NAN).is_err());
     }
 
+    /// The shape's geometry without descriptors (the map step's default ignores them).
+    fn geometry<'a>(mesh: &'a TriMesh, data: &'a ShapeData) -> ShapeGeometry<'a> {
+        ShapeGeometry {
+            spectrum: &data.spectrum,
+            positions: mesh.positions(),
+            descriptors: None,
+        }
+    }
+
     fn pair_shape<'a>(mesh: &'a TriMesh, data: &'a ShapeData) -> PairShape<'a> {
         PairShape {
             mesh,
@@ -1112,16 +1110,8 @@ mod map_guided {
         let by_hand = map_guided_refinement(
             &w,
             &refined,
-            ShapeGeometry {
-                spectrum: &da.spectrum,
-                positions: a.positions(),
-                descriptors: None,
-            },
-            ShapeGeometry {
-                spectrum: &db.spectrum,
-                positions: b.positions(),
-                descriptors: None,
-            },
+            geometry(&a, &da),
+            geometry(&b, &db),
             Some(&smoother(&b, map_guided.smoothing_time)),
             map_guided,
         )
