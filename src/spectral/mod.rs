@@ -5,6 +5,7 @@
 //! eigenvalues, diffusion times and energies mean the same on every shape of a collection,
 //! whatever the units of its file. Eigenvectors are M-orthonormal for the unit-area mass.
 
+mod auction_assignment;
 mod block_lanczos;
 mod cotan_laplacian;
 mod heat_smoother;
@@ -13,6 +14,7 @@ mod lumped_mass;
 mod shift_invert;
 pub(crate) mod zoomout;
 
+pub use auction_assignment::{Assignment, AuctionOptions, CandidateLists, auction_assignment};
 pub use cotan_laplacian::cotan_laplacian;
 pub use heat_smoother::HeatSmoother;
 pub use laplace_beltrami_spectrum::{
@@ -20,7 +22,7 @@ pub use laplace_beltrami_spectrum::{
     laplace_beltrami_spectrum_with_stats,
 };
 pub use lumped_mass::lumped_mass;
-pub use zoomout::{ShapeGeometry, ZoomOutOptions, zoomout};
+pub use zoomout::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
 
 use thiserror::Error;
 

@@ -1,7 +1,7 @@
 //! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
 //! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
 
-use super::{SpectralError, Spectrum};
+use super::{AuctionOptions, CandidateLists, SpectralError, Spectrum, auction_assignment};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 use nalgebra::DMatrix;
@@ -28,6 +28,9 @@ pub struct ZoomOutOptions {
     /// coordinates; on near-isometric pairs they pin the map where the spectral embedding
     /// drifts (see [`MapGuidedOptions::near_isometric`](crate::stable::MapGuidedOptions)).
     pub descriptor_weight: f64,
+    /// How the last point map is read from the embeddings (default
+    /// [`FinalMatch::default`]: a near-bijective assignment).
+    pub final_match: FinalMatch,
 }
 
 impl Default for ZoomOutOptions {
@@ -38,6 +41,36 @@ impl Default for ZoomOutOptions {
             step: 5,
             samples: 2000,
             descriptor_weight: 0.0,
+            final_match: FinalMatch::default(),
+        }
+    }
+}
+
+/// How [`zoomout`] reads its last point map over all vertices.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum FinalMatch {
+    /// Every vertex of B takes the nearest row of A (ZoomOut as published): many-to-one
+    /// where the embedding is compressed.
+    Nearest,
+    /// Every vertex of B takes one of its `candidates` nearest rows of A by
+    /// [`auction_assignment`]: one-to-one between shapes of equal vertex count, balanced
+    /// otherwise.
+    Bijective {
+        /// Candidates per vertex (default 64).
+        candidates: usize,
+        /// The assignment's options.
+        auction: AuctionOptions,
+    },
+}
+
+impl Default for FinalMatch {
+    /// `Bijective` with 64 candidates and [`AuctionOptions::default`]: on the TOSCA
+    /// within-class pairs it places the map step's boundaries 0.4–1 point of correspondence
+    /// ratio better than `Nearest` (README), for about 0.3 s on 10,000 vertices.
+    fn default() -> Self {
+        FinalMatch::Bijective {
+            candidates: 64,
+            auction: AuctionOptions::default(),
         }
     }
 }
@@ -199,9 +232,32 @@ pub(crate) fn zoomout_from(
         (Some(da), Some(db)) if lambda > 0.0 => {
             let base = with_descriptors(base.as_ref(), da, lambda);
             let query = with_descriptors(phi_b.subcols(0, k), db, lambda);
-            Ok(nearest_rows(&base, query.as_ref()))
+            final_point_map(&base, query.as_ref(), &options.final_match)
         }
-        _ => Ok(nearest_rows(&base, phi_b.subcols(0, k))),
+        _ => final_point_map(&base, phi_b.subcols(0, k), &options.final_match),
+    }
+}
+
+/// The last point map: rows of `query` (B) to rows of `base` (A).
+fn final_point_map(
+    base: &Mat<f64>,
+    query: MatRef<'_, f64>,
+    final_match: &FinalMatch,
+) -> Result<Vec<u32>, SpectralError> {
+    match final_match {
+        FinalMatch::Nearest => Ok(nearest_rows(base, query)),
+        FinalMatch::Bijective {
+            candidates,
+            auction,
+        } => {
+            if *candidates == 0 {
+                return Err(SpectralError::InvalidOption(
+                    "a bijective final match needs at least 1 candidate".into(),
+                ));
+            }
+            let lists = nearest_candidates(base, query, *candidates);
+            Ok(auction_assignment(&lists, base.nrows(), auction)?.map)
+        }
     }
 }
 
@@ -302,12 +358,19 @@ const QUERY_BLOCK: usize = 128;
 /// For every row of `query`, the index of the nearest row of `base` (Euclidean; ties to the
 /// lowest index). Both have the same number of columns.
 fn nearest_rows(base: &Mat<f64>, query: MatRef<'_, f64>) -> Vec<u32> {
+    nearest_candidates(base, query, 1).targets
+}
+
+/// For every row of `query`, the `count` nearest rows of `base` (capped by its rows) and
+/// their squared distances, nearest first (ties to the lowest index).
+fn nearest_candidates(base: &Mat<f64>, query: MatRef<'_, f64>, count: usize) -> CandidateLists {
     let n = base.nrows();
+    let count = count.min(n).max(1);
     let norms: Vec<f64> = (0..n)
         .map(|i| (0..base.ncols()).map(|j| base[(i, j)] * base[(i, j)]).sum())
         .collect();
     let starts: Vec<usize> = (0..query.nrows()).step_by(QUERY_BLOCK).collect();
-    starts
+    let pairs: Vec<(u32, f64)> = starts
         .par_iter()
         .flat_map_iter(|&r0| {
             let m = QUERY_BLOCK.min(query.nrows() - r0);
@@ -320,19 +383,30 @@ fn nearest_rows(base: &Mat<f64>, query: MatRef<'_, f64>) -> Vec<u32> {
                 1.0,
                 Par::Seq,
             );
-            (0..m)
-                .map(|j| {
-                    let col = dots.col(j);
-                    let mut best = (f64::INFINITY, 0usize);
-                    for (i, &norm) in norms.iter().enumerate() {
-                        let d = norm - 2.0 * col[i];
-                        if d < best.0 {
-                            best = (d, i);
-                        }
+            let mut out = Vec::with_capacity(m * count);
+            let mut best: Vec<(f64, u32)> = Vec::with_capacity(count + 1);
+            for j in 0..m {
+                let col = dots.col(j);
+                best.clear();
+                // `‖a‖² − 2 a·q` orders the rows as the squared distance does; `‖q‖²` is added
+                // to the kept ones only.
+                for (i, &norm) in norms.iter().enumerate() {
+                    let d = norm - 2.0 * col[i];
+                    if best.len() < count || d < best[count - 1].0 {
+                        let at = best.partition_point(|x| x.0 <= d);
+                        best.insert(at, (d, i as u32));
+                        best.truncate(count);
                     }
-                    best.1 as u32
-                })
-                .collect::<Vec<_>>()
+                }
+                let q_norm: f64 = (0..query.ncols()).map(|c| query[(r0 + j, c)].powi(2)).sum();
+                out.extend(best.iter().map(|&(d, i)| (i, (d + q_norm).max(0.0))));
+            }
+            out
         })
-        .collect()
+        .collect();
+    CandidateLists {
+        per_query: count,
+        targets: pairs.iter().map(|p| p.0).collect(),
+        costs: pairs.iter().map(|p| p.1).collect(),
+    }
 }

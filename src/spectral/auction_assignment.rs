@@ -1,0 +1,230 @@
+//! [`auction_assignment`]: a near-bijective assignment of queries to targets over sparse
+//! candidate lists (Bertsekas' auction algorithm), used by
+//! [`zoomout`](super::zoomout) to read its last point map.
+
+use super::SpectralError;
+use serde::{Deserialize, Serialize};
+use std::collections::VecDeque;
+
+/// For every query, its `per_query` best candidate targets and their costs, sorted by cost
+/// ascending (the first is the query's nearest target).
+///
+/// Layout: query `q`'s candidates are `targets[q·per_query .. (q+1)·per_query]`, with costs
+/// at the same positions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CandidateLists {
+    /// Candidates per query (at least 1).
+    pub per_query: usize,
+    /// Candidate target indices, `queries × per_query`.
+    pub targets: Vec<u32>,
+    /// Their costs (finite, non-negative; e.g. squared embedding distances), same layout.
+    pub costs: Vec<f64>,
+}
+
+impl CandidateLists {
+    /// Number of queries.
+    pub fn queries(&self) -> usize {
+        self.targets.len().checked_div(self.per_query).unwrap_or(0)
+    }
+}
+
+/// Options of [`auction_assignment`]. Costs are measured in units of the *cost scale*: the
+/// median over queries of the nearest candidate's cost.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct AuctionOptions {
+    /// Extra cost, in cost-scale units, at which a query gives up exclusivity and shares its
+    /// nearest target instead (default 20). `0` returns the nearest targets; larger values
+    /// approach a true bijection at the price of longer bidding wars.
+    pub penalty: f64,
+    /// Bid increment ε in cost-scale units (default `0.03`): the assignment's total cost is
+    /// within `queries · ε` of the optimum over the candidates, and the bidding takes
+    /// `O(1/ε)` rounds where targets are contested. On the TOSCA pairs `1e-3` gives the same
+    /// correspondence ratio for a 3× longer auction.
+    pub epsilon: f64,
+}
+
+impl Default for AuctionOptions {
+    fn default() -> Self {
+        AuctionOptions {
+            penalty: 20.0,
+            epsilon: 0.03,
+        }
+    }
+}
+
+/// The result of [`auction_assignment`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Assignment {
+    /// The target of every query.
+    pub map: Vec<u32>,
+    /// Queries that hold a target slot of their own (the rest share their nearest target).
+    pub exclusive: usize,
+    /// Bids made over all phases (a measure of the work done).
+    pub bids: usize,
+}
+
+/// Assigns every query to one of its candidate targets so that no target takes more than
+/// `⌈queries / target_count⌉` queries (one each when there are no more queries than targets:
+/// a bijection between shapes of equal vertex count) and the total cost is minimal, up to
+/// `queries · ε`; a query whose candidates are all more contested than
+/// [`AuctionOptions::penalty`] is worth takes its nearest target without a slot.
+///
+/// Why: a nearest-neighbour point map sends many vertices to one and leaves others without a
+/// preimage wherever an embedding is compressed; a true correspondence between two
+/// samplings of one surface is (near) one-to-one, so asking for it moves the crowded matches
+/// to their free second-best neighbours. On the TOSCA within-class pairs this lifts the map
+/// step by 0.4–1 point of correspondence ratio (README).
+///
+/// Sequential and deterministic (queries bid in index order, first-in first-out; ties go to
+/// the earlier candidate). Terminates: every bid raises a price by at least `ε`, and no
+/// query bids above its outside option.
+///
+/// ```
+/// use coseg::spectral::{auction_assignment, AuctionOptions, CandidateLists};
+/// // Two queries whose nearest target is 0; query 1 has target 1 almost as near.
+/// let lists = CandidateLists { per_query: 2, targets: vec![0, 1, 0, 1], costs: vec![1.0, 5.0, 1.0, 1.5] };
+/// let out = auction_assignment(&lists, 2, &AuctionOptions::default()).unwrap();
+/// assert_eq!(out.map, vec![0, 1]);
+/// assert_eq!(out.exclusive, 2);
+/// ```
+pub fn auction_assignment(
+    candidates: &CandidateLists,
+    target_count: usize,
+    options: &AuctionOptions,
+) -> Result<Assignment, SpectralError> {
+    validate(candidates, target_count, options)?;
+    let k = candidates.per_query;
+    let queries = candidates.queries();
+    if queries == 0 {
+        return Ok(Assignment {
+            map: Vec::new(),
+            exclusive: 0,
+            bids: 0,
+        });
+    }
+    let scale = cost_scale(candidates);
+    let capacity = queries.div_ceil(target_count);
+    let penalty = options.penalty * scale;
+    // Slot `t · capacity + s` is the `s`-th place of target `t`.
+    let mut price = vec![0.0f64; target_count * capacity];
+    let mut owner = vec![u32::MAX; target_count * capacity];
+    let mut map = vec![0u32; queries];
+    let mut bids = 0usize;
+    let epsilon = options.epsilon * scale;
+    let mut queue: VecDeque<usize> = (0..queries).collect();
+    while let Some(q) = queue.pop_front() {
+        bids += 1;
+        let targets = &candidates.targets[q * k..(q + 1) * k];
+        let costs = &candidates.costs[q * k..(q + 1) * k];
+        let outside = -(costs[0] + penalty);
+        let (mut best, mut second, mut best_slot) = (outside, f64::NEG_INFINITY, None);
+        for (&t, &cost) in targets.iter().zip(costs) {
+            let slots = t as usize * capacity..(t as usize + 1) * capacity;
+            let slot = slots
+                .min_by(|&x, &y| price[x].total_cmp(&price[y]))
+                .expect("capacity is at least 1");
+            let value = -cost - price[slot];
+            if value > best {
+                second = best;
+                best = value;
+                best_slot = Some(slot);
+            } else if value > second {
+                second = value;
+            }
+        }
+        let Some(slot) = best_slot else {
+            map[q] = targets[0];
+            continue;
+        };
+        price[slot] += best - second + epsilon;
+        let previous = std::mem::replace(&mut owner[slot], q as u32);
+        map[q] = (slot / capacity) as u32;
+        if previous != u32::MAX {
+            queue.push_back(previous as usize);
+        }
+    }
+    let exclusive = owner.iter().filter(|&&o| o != u32::MAX).count();
+    Ok(Assignment {
+        map,
+        exclusive,
+        bids,
+    })
+}
+
+/// The median nearest cost, or (when it is 0: exact matches) the mean candidate cost, or 1.
+fn cost_scale(candidates: &CandidateLists) -> f64 {
+    let mut nearest: Vec<f64> = candidates
+        .costs
+        .chunks_exact(candidates.per_query)
+        .map(|c| c[0])
+        .collect();
+    let mid = nearest.len() / 2;
+    let median = *nearest.select_nth_unstable_by(mid, f64::total_cmp).1;
+    if median > 0.0 {
+        return median;
+    }
+    let mean = candidates.costs.iter().sum::<f64>() / candidates.costs.len() as f64;
+    if mean > 0.0 { mean } else { 1.0 }
+}
+
+fn validate(
+    candidates: &CandidateLists,
+    target_count: usize,
+    options: &AuctionOptions,
+) -> Result<(), SpectralError> {
+    let bad = |m: String| {
+        Err(SpectralError::InvalidOption(format!(
+            "auction assignment: {m}"
+        )))
+    };
+    let k = candidates.per_query;
+    if k == 0
+        || !candidates.targets.len().is_multiple_of(k)
+        || candidates.costs.len() != candidates.targets.len()
+    {
+        return bad(format!(
+            "{} targets and {} costs are not whole lists of {k} candidates",
+            candidates.targets.len(),
+            candidates.costs.len()
+        ));
+    }
+    if !candidates.targets.is_empty() && target_count == 0 {
+        return bad("candidates given but there are no targets".into());
+    }
+    if let Some(&t) = candidates
+        .targets
+        .iter()
+        .find(|&&t| t as usize >= target_count)
+    {
+        return bad(format!(
+            "candidate target {t} but only {target_count} targets"
+        ));
+    }
+    if let Some(c) = candidates
+        .costs
+        .iter()
+        .find(|c| !(c.is_finite() && **c >= 0.0))
+    {
+        return bad(format!("cost {c} is not finite and non-negative"));
+    }
+    if let Some(q) = candidates
+        .costs
+        .chunks_exact(k)
+        .position(|c| c.windows(2).any(|w| w[1] < w[0]))
+    {
+        return bad(format!("the costs of query {q} are not sorted ascending"));
+    }
+    if !(options.penalty.is_finite() && options.penalty >= 0.0) {
+        return bad(format!(
+            "penalty = {} must be finite and non-negative",
+            options.penalty
+        ));
+    }
+    if !(options.epsilon.is_finite() && options.epsilon > 0.0) {
+        return bad(format!(
+            "epsilon = {} must be finite and positive",
+            options.epsilon
+        ));
+    }
+    Ok(())
+}
