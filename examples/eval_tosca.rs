@@ -2,13 +2,16 @@
 //!
 //! ```text
 //! cargo run --release --example eval_tosca -- /work/shared/data/tosca [--cache DIR]
-//!     [--shapes 4] [--seed 0] [--map-weight β] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
+//!     [--shapes 4] [--seed 0] [--map-weight β] [--nearest] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
 //!     [--area-bands] [--eigenpairs k] [--hks n] [--wks n] [--curvature n]
 //! ```
 //! For every class, the first `--shapes` files `<class><i>.off` in increasing `i` are taken and
 //! every unordered pair is segmented; the table gives the mean ratio per class and overall for
 //! each configuration (Algorithm 2 at a 10 % area cutoff, Algorithm 3), plus the time spent in
 //! the stable-region algorithm (per-shape data are cached and excluded).
+//!
+//! `--nearest` reads the map step's last point map by nearest neighbours (ZoomOut as
+//! published) instead of the default one-to-one assignment.
 //!
 //! The `*-oracle-*` configurations are diagnostics, not methods: they replace the map step's
 //! map by ZoomOut started from the ground truth, to measure what a perfect start of the map
@@ -18,11 +21,12 @@ use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
 use coseg::cache::{ShapeData, ShapePipelineOptions, load_or_compute};
 use coseg::mesh::{TriMesh, read_mesh};
-use coseg::spectral::{HeatSmoother, ZoomOutOptions, zoomout};
+use coseg::spectral::{FinalMatch, HeatSmoother, ZoomOutOptions, zoomout};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions,
-    ShapeGeometry, StableRegionsOptions, TSearch, VertexMap, correspondence_stats,
-    point_map_refinement, refine_regions, segment_pair, stable_regions,
+    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, PairShape, RefineOptions,
+    SegmentPairOptions, ShapeGeometry, StableRegionsOptions, TSearch, VertexMap,
+    correspondence_stats, map_preset, point_map_refinement, refine_regions, segment_pair,
+    stable_regions,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -35,8 +39,11 @@ enum Post {
     Refine,
     /// [`segment_pair`] with default refinement and map step (what `coseg pair` runs).
     RefineMap,
-    /// The same with [`MapGuidedOptions::near_isometric`] (`coseg pair --near-isometric`).
+    /// The same with [`MapGuidedOptions::near_isometric`] (`coseg pair --map-preset
+    /// near-isometric`).
     RefineMapIsometric,
+    /// The same with the preset [`map_preset`] picks for the pair (`coseg pair`'s default).
+    RefineMapAuto,
     /// Diagnostic, not a method: [`refine_regions`], then [`point_map_refinement`] with
     /// weight `β` and a ZoomOut map started from the ground truth (what the map step would
     /// give if its map were as good as ZoomOut can make it).
@@ -169,6 +176,22 @@ fn configs() -> Vec<(&'static str, StableRegionsOptions, Post)> {
             Post::RefineMapIsometric,
         ),
         (
+            "alg2-random-mapped-auto",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..base.clone()
+            },
+            Post::RefineMapAuto,
+        ),
+        (
+            "alg3-random-mapped-auto",
+            StableRegionsOptions {
+                init: Init::Random,
+                ..auto.clone()
+            },
+            Post::RefineMapAuto,
+        ),
+        (
             "alg2-random-oracle-map",
             StableRegionsOptions {
                 init: Init::Random,
@@ -202,6 +225,7 @@ fn main() -> anyhow::Result<()> {
     let mut shapes = 4usize;
     let mut seed = 0u64;
     let mut map_step = MapGuidedOptions::default();
+    let mut nearest = false;
     let mut classes = vec![
         "cat".to_string(),
         "dog".into(),
@@ -222,6 +246,7 @@ fn main() -> anyhow::Result<()> {
                 map_step.map_weight = next(i).parse()?;
                 i += 1;
             }
+            "--nearest" => nearest = true,
             "--seed" => {
                 seed = next(i).parse()?;
                 i += 1;
@@ -330,7 +355,10 @@ fn main() -> anyhow::Result<()> {
                         )?)
                     };
                     // What `coseg pair` runs (its smoothers' set-up is timed too).
-                    let whole_stage = |map_guided: MapGuidedOptions| -> anyhow::Result<_> {
+                    let whole_stage = |mut map_guided: MapGuidedOptions| -> anyhow::Result<_> {
+                        if nearest {
+                            map_guided.point_map.zoomout.final_match = FinalMatch::Nearest;
+                        }
                         let options = SegmentPairOptions {
                             regions: opts.clone(),
                             map_guided: Some(map_guided),
@@ -344,6 +372,16 @@ fn main() -> anyhow::Result<()> {
                         Post::RefineMap => whole_stage(map_step.clone())?,
                         Post::RefineMapIsometric => {
                             whole_stage(MapGuidedOptions::near_isometric())?
+                        }
+                        Post::RefineMapAuto => {
+                            let choice = map_preset(&sa.data.spectrum, &sb.data.spectrum)?;
+                            if choice.preset != MapPreset::NearIsometric {
+                                println!(
+                                    "  {} x {}: general preset (discrepancy {:.4})",
+                                    sa.name, sb.name, choice.discrepancy
+                                );
+                            }
+                            whole_stage(choice.preset.options())?
                         }
                         Post::RefineOracleMap(weight) => {
                             let refined = refined()?;

@@ -311,3 +311,46 @@ fn segment_reports_a_malformed_mesh_and_segments_the_rest() {
     assert!(!out.join("broken.regions.txt").exists());
     summary(&out);
 }
+
+#[test]
+fn pair_map_preset_follows_the_spectra() {
+    use coseg::stable::NEAR_ISOMETRIC_DISCREPANCY;
+    let run = pair_run();
+    assert_success(run);
+    // Two different generated bodies: the general preset.
+    let json = summary(&run.out);
+    assert_eq!(
+        json["map_preset"]["preset"], "General",
+        "{}",
+        json["map_preset"]
+    );
+    let discrepancy = json["map_preset"]["discrepancy"].as_f64().unwrap();
+    assert!(discrepancy > NEAR_ISOMETRIC_DISCREPANCY, "{discrepancy}");
+    // A body against itself is isometric.
+    let a = quadrupeds().join(format!("{PAIR_A}.obj"));
+    let out = scratch("pair_self");
+    let same = coseg(&["pair".as_ref(), &a, &a, "-o".as_ref(), &out]);
+    assert!(
+        same.status.success(),
+        "{}",
+        String::from_utf8_lossy(&same.stderr)
+    );
+    let json = summary(&out);
+    assert_eq!(json["map_preset"]["preset"], "NearIsometric");
+    assert_eq!(json["map_preset"]["discrepancy"].as_f64(), Some(0.0));
+    // An explicit preset and its shorthand conflict: a usage error, nothing written.
+    let out = scratch("pair_conflict");
+    let args: [&Path; 8] = [
+        "pair".as_ref(),
+        &a,
+        &a,
+        "-o".as_ref(),
+        &out,
+        "--near-isometric".as_ref(),
+        "--map-preset".as_ref(),
+        "general".as_ref(),
+    ];
+    let conflict = coseg(&args);
+    assert_eq!(conflict.status.code(), Some(2));
+    assert_eq!(std::fs::read_dir(&out).unwrap().count(), 0);
+}

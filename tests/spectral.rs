@@ -872,3 +872,36 @@ mod auction {
         }
     }
 }
+
+mod discrepancy {
+    use super::common::features::{blob, permutation, permute_mesh};
+    use coseg::spectral::{SpectrumOptions, eigenvalue_discrepancy, laplace_beltrami_spectrum};
+
+    #[test]
+    fn eigenvalue_discrepancy_is_zero_for_isometric_copies_and_grows_with_stretch() {
+        let a = blob(2);
+        let opts = SpectrumOptions::with_eigenpairs(20);
+        let spectrum = |m| laplace_beltrami_spectrum(m, &opts).unwrap();
+        let sa = spectrum(&a);
+        // Permuted, scaled and rotated copies have the same unit-area spectrum.
+        let perm = permutation(a.vertex_count(), 3);
+        let copy = permute_mesh(&a, &perm)
+            .map_positions(|p| [3.0 * p[1], -3.0 * p[0], 3.0 * p[2] + 1.0])
+            .unwrap();
+        let same = eigenvalue_discrepancy(&sa, &spectrum(&copy), 20).unwrap();
+        assert!(same < 1e-6, "{same}");
+        // Stretching one axis is not an isometry; more stretch, more discrepancy.
+        let stretch = |f: f64| a.map_positions(|p| [f * p[0], p[1], p[2]]).unwrap();
+        let (s1, s2) = (spectrum(&stretch(1.3)), spectrum(&stretch(2.0)));
+        let d1 = eigenvalue_discrepancy(&sa, &s1, 20).unwrap();
+        let d2 = eigenvalue_discrepancy(&sa, &s2, 20).unwrap();
+        assert!(0.01 < d1 && d1 < d2 && d2 < 1.0, "{d1} {d2}");
+        assert_eq!(
+            d1,
+            eigenvalue_discrepancy(&s1, &sa, 20).unwrap(),
+            "symmetric"
+        );
+        assert!(eigenvalue_discrepancy(&sa, &s1, 1).is_err());
+        assert!(eigenvalue_discrepancy(&sa, &s1, 21).is_err());
+    }
+}

@@ -1132,3 +1132,36 @@ mod map_guided {
         assert!(segment_pair(sa, mismatched, &options).is_err());
     }
 }
+
+mod preset {
+    use super::common::features::{blob, permutation, permute_mesh};
+    use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
+    use coseg::stable::{MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY, map_preset};
+
+    #[test]
+    fn map_preset_tells_a_repose_from_a_different_body() {
+        let a = blob(2);
+        let opts = SpectrumOptions::with_eigenpairs(24);
+        let spectrum = |m| laplace_beltrami_spectrum(m, &opts).unwrap();
+        let sa = spectrum(&a);
+        let copy = permute_mesh(&a, &permutation(a.vertex_count(), 9));
+        let same = map_preset(&sa, &spectrum(&copy)).unwrap();
+        assert_eq!(same.preset, MapPreset::NearIsometric);
+        assert!(same.discrepancy < 1e-6);
+        let other = a.map_positions(|p| [1.6 * p[0], p[1], p[2]]).unwrap();
+        let different = map_preset(&sa, &spectrum(&other)).unwrap();
+        assert_eq!(different.preset, MapPreset::General);
+        assert!(different.discrepancy >= NEAR_ISOMETRIC_DISCREPANCY);
+        assert_eq!(MapPreset::General.options(), MapGuidedOptions::default());
+        assert_eq!(
+            MapPreset::NearIsometric.options(),
+            MapGuidedOptions::near_isometric()
+        );
+        // Spectra shorter than the 20 eigenvalues compared: the common length is used.
+        let short = laplace_beltrami_spectrum(&a, &SpectrumOptions::with_eigenpairs(5)).unwrap();
+        assert_eq!(
+            map_preset(&sa, &short).unwrap().preset,
+            MapPreset::NearIsometric
+        );
+    }
+}

@@ -7,8 +7,9 @@ use coseg::mesh::read_mesh_with_report;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
 use coseg::spectral::ZoomOutOptions;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, PointMapOptions, RefineOptions,
-    SegmentPairOptions, StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio,
+    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY,
+    PairShape, PointMapOptions, PresetChoice, RefineOptions, SegmentPairOptions,
+    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, map_preset,
     segment_pair,
 };
 use std::path::{Path, PathBuf};
@@ -29,6 +30,16 @@ enum InitArg {
     Extreme,
     /// Random half of the remaining vertices (seeded).
     Random,
+}
+
+#[derive(Debug, Clone, Copy, ValueEnum)]
+enum MapPresetArg {
+    /// `near-isometric` when the two spectra agree, else `general`.
+    Auto,
+    /// For different bodies (`MapGuidedOptions::default`).
+    General,
+    /// For two poses of one body (`MapGuidedOptions::near_isometric`).
+    NearIsometric,
 }
 
 #[derive(Debug, Args)]
@@ -84,13 +95,18 @@ pub struct PairArgs {
     /// Weight of the point map's vote in the last step, which re-assigns B's vertices by band
     /// affinity plus a functional-map point map fitted to the region pairs (see
     /// `coseg::stable::map_guided_refinement`); 0 skips the step.
-    /// [default: 0.5, or 2 with --near-isometric]
+    /// [default: 0.5, or 2 with the near-isometric preset]
     #[arg(long)]
     map_weight: Option<f64>,
-    /// Tune the map step for near-isometric pairs (two poses of one body): a stronger vote
-    /// and descriptors in the point map's last match (`MapGuidedOptions::near_isometric`).
-    /// Better on such pairs (TOSCA within-class: 94.6 % against 94.0 %), worse on others.
-    #[arg(long)]
+    /// Options of the map step: `near-isometric` (two poses of one body: a stronger vote and
+    /// descriptors in the point map's last match; TOSCA within-class 95.7 % against 94.3 %,
+    /// but worse on different bodies), `general`, or `auto`, which picks `near-isometric`
+    /// when the two spectra agree (eigenvalue discrepancy below 0.03, see
+    /// `coseg::stable::map_preset`).
+    #[arg(long, value_enum, default_value = "auto")]
+    map_preset: MapPresetArg,
+    /// Same as `--map-preset near-isometric`.
+    #[arg(long, conflicts_with = "map_preset")]
     near_isometric: bool,
     /// Size of the last functional map of that step (capped by the eigenpairs computed).
     #[arg(long, default_value_t = ZoomOutOptions::default().final_size)]
@@ -171,11 +187,14 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         max_rounds: args.refine_rounds,
         smoothing_time: args.smoothing_time,
     });
-    let preset = if args.near_isometric {
-        MapGuidedOptions::near_isometric()
-    } else {
-        MapGuidedOptions::default()
+    let choice = map_preset(&da.spectrum, &db.spectrum)
+        .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
+    let chosen = match (args.near_isometric, args.map_preset) {
+        (true, _) | (false, MapPresetArg::NearIsometric) => MapPreset::NearIsometric,
+        (false, MapPresetArg::General) => MapPreset::General,
+        (false, MapPresetArg::Auto) => choice.preset,
     };
+    let preset = chosen.options();
     let map_weight = args.map_weight.unwrap_or(preset.map_weight);
     let map_guided = (map_weight > 0.0).then(|| MapGuidedOptions {
         point_map: PointMapOptions {
@@ -243,7 +262,11 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         seconds,
     )
     .with_refine(pair_options.refine)
-    .with_map_guided(pair_options.map_guided);
+    .with_map_guided(pair_options.map_guided.clone())
+    .with_map_preset(pair_options.map_guided.as_ref().map(|_| PresetChoice {
+        preset: chosen,
+        discrepancy: choice.discrepancy,
+    }));
     let shapes = [
         ShapeRegions {
             name: &na,
@@ -257,6 +280,17 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         },
     ];
     let written = write_regions(&args.output, &shapes, &summary)?;
+    if pair_options.map_guided.is_some() {
+        println!(
+            "map step: {} preset (eigenvalue discrepancy {:.4}; near-isometric below {})",
+            match chosen {
+                MapPreset::General => "general",
+                MapPreset::NearIsometric => "near-isometric",
+            },
+            choice.discrepancy,
+            NEAR_ISOMETRIC_DISCREPANCY
+        );
+    }
     println!(
         "{} x {}: {} region pairs in {:.3} s{} -> {} files in {}",
         args.a.display(),

@@ -1,6 +1,8 @@
 //! [`PairSummary`]: the `summary.json` of a two-shape stable-region run.
 
-use crate::stable::{MapGuidedOptions, RefineOptions, StableRegions, StableRegionsOptions};
+use crate::stable::{
+    MapGuidedOptions, PresetChoice, RefineOptions, StableRegions, StableRegionsOptions,
+};
 use serde::Serialize;
 
 /// One shape of a pair run.
@@ -52,6 +54,9 @@ pub struct PairSummary {
     /// The map-guided refinement of B's regions applied last, if any (see
     /// [`map_guided_refinement`](crate::stable::map_guided_refinement)).
     pub map_guided: Option<MapGuidedOptions>,
+    /// Which preset the map step's options came from and the pair's eigenvalue discrepancy
+    /// (see [`map_preset`](crate::stable::map_preset)), when the step ran.
+    pub map_preset: Option<PresetChoice>,
     /// Per-region statistics, in region-id order.
     pub regions: Vec<RegionSummary>,
     /// Correspondence ratio against the given ground truth, if any (fraction in `[0, 1]`).
@@ -102,6 +107,7 @@ impl PairSummary {
             options: options.clone(),
             refine: None,
             map_guided: None,
+            map_preset: None,
             regions,
             correspondence_ratio,
             seconds,
@@ -119,6 +125,12 @@ impl PairSummary {
     /// [`map_guided_refinement`](crate::stable::map_guided_refinement) with `options`.
     pub fn with_map_guided(mut self, options: Option<MapGuidedOptions>) -> Self {
         self.map_guided = options;
+        self
+    }
+
+    /// Records the map step's preset choice.
+    pub fn with_map_preset(mut self, choice: Option<PresetChoice>) -> Self {
+        self.map_preset = choice;
         self
     }
 }

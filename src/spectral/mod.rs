@@ -8,6 +8,7 @@
 mod auction_assignment;
 mod block_lanczos;
 mod cotan_laplacian;
+mod eigenvalue_discrepancy;
 mod heat_smoother;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
@@ -16,6 +17,7 @@ pub(crate) mod zoomout;
 
 pub use auction_assignment::{Assignment, AuctionOptions, CandidateLists, auction_assignment};
 pub use cotan_laplacian::cotan_laplacian;
+pub use eigenvalue_discrepancy::eigenvalue_discrepancy;
 pub use heat_smoother::HeatSmoother;
 pub use laplace_beltrami_spectrum::{
     SpectrumOptions, SpectrumStats, dense_spectrum, laplace_beltrami_spectrum,

@@ -17,6 +17,7 @@
 mod correspondence_ratio;
 mod initial_indicator;
 mod map_guided_refinement;
+mod map_preset;
 mod refine_partition;
 mod refine_regions;
 mod region_point_map;
@@ -33,6 +34,9 @@ pub use correspondence_ratio::{
 };
 pub use initial_indicator::{Init, initial_indicator};
 pub use map_guided_refinement::{MapGuidedOptions, map_guided_refinement, point_map_refinement};
+pub use map_preset::{
+    MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PRESET_EIGENVALUES, PresetChoice, map_preset,
+};
 pub use refine_partition::{
     RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
 };
