@@ -18,8 +18,9 @@ use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
 use coseg::mesh::read_mesh;
 use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions, ShapeGeometry, StableRegions,
-    StableRegionsOptions, map_guided_refinement, refine_regions, segment_pair, stable_regions,
+    PairShape, RefineOptions, SegmentPairOptions, ShapeGeometry, StableRegions,
+    StableRegionsOptions, map_guided_refinement, map_preset, refine_regions, segment_pair,
+    stable_regions,
 };
 use std::path::Path;
 
@@ -62,7 +63,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Last, as `coseg pair` does by default: B's regions re-assigned with a point map read from
     // a functional map fitted to the region pairs (smoothed more lightly than the refinement).
-    let map_step = MapGuidedOptions::default();
+    // Its options depend on how near-isometric the pair is, which the spectra tell.
+    let choice = map_preset(&data_a.spectrum, &data_b.spectrum)?;
+    println!(
+        "map step preset {:?} (eigenvalue discrepancy {:.4})",
+        choice.preset, choice.discrepancy
+    );
+    let map_step = choice.preset.options();
     let map_smoother_b = HeatSmoother::new(&mesh_b, map_step.smoothing_time)?;
     let mapped = map_guided_refinement(
         &w,
@@ -95,7 +102,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bands: &data_b.bands,
             descriptors: Some(&data_b.descriptors.values),
         },
-        &SegmentPairOptions::default(),
+        &SegmentPairOptions {
+            map_guided: Some(choice.preset.options()),
+            ..Default::default()
+        },
     )?;
     assert_eq!(one_call.regions, mapped);
 

@@ -370,9 +370,9 @@ fn nearest_candidates(base: &Mat<f64>, query: MatRef<'_, f64>, count: usize) -> 
         .map(|i| (0..base.ncols()).map(|j| base[(i, j)] * base[(i, j)]).sum())
         .collect();
     let starts: Vec<usize> = (0..query.nrows()).step_by(QUERY_BLOCK).collect();
-    let pairs: Vec<(u32, f64)> = starts
+    let blocks: Vec<(Vec<u32>, Vec<f64>)> = starts
         .par_iter()
-        .flat_map_iter(|&r0| {
+        .map(|&r0| {
             let m = QUERY_BLOCK.min(query.nrows() - r0);
             let mut dots = Mat::<f64>::zeros(n, m);
             matmul(
@@ -383,7 +383,8 @@ fn nearest_candidates(base: &Mat<f64>, query: MatRef<'_, f64>, count: usize) -> 
                 1.0,
                 Par::Seq,
             );
-            let mut out = Vec::with_capacity(m * count);
+            let (mut targets, mut costs) =
+                (Vec::with_capacity(m * count), Vec::with_capacity(m * count));
             let mut best: Vec<(f64, u32)> = Vec::with_capacity(count + 1);
             for j in 0..m {
                 let col = dots.col(j);
@@ -399,14 +400,15 @@ fn nearest_candidates(base: &Mat<f64>, query: MatRef<'_, f64>, count: usize) -> 
                     }
                 }
                 let q_norm: f64 = (0..query.ncols()).map(|c| query[(r0 + j, c)].powi(2)).sum();
-                out.extend(best.iter().map(|&(d, i)| (i, (d + q_norm).max(0.0))));
+                targets.extend(best.iter().map(|&(_, i)| i));
+                costs.extend(best.iter().map(|&(d, _)| (d + q_norm).max(0.0)));
             }
-            out
+            (targets, costs)
         })
         .collect();
     CandidateLists {
         per_query: count,
-        targets: pairs.iter().map(|p| p.0).collect(),
-        costs: pairs.iter().map(|p| p.1).collect(),
+        targets: blocks.iter().flat_map(|b| b.0.iter().copied()).collect(),
+        costs: blocks.iter().flat_map(|b| b.1.iter().copied()).collect(),
     }
 }

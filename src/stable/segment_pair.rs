@@ -12,8 +12,10 @@ use crate::spectral::{HeatSmoother, ShapeGeometry, Spectrum};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
-/// Options of [`segment_pair`]. The defaults are the configuration that scores best on the
-/// TOSCA within-class pairs (README, "Quality").
+/// Options of [`segment_pair`]. The defaults suit any pair; `coseg pair` replaces the map
+/// step's options by those [`map_preset`](super::map_preset) picks from the two spectra
+/// (`MapPreset::options`), which on two poses of one body is the configuration that scores
+/// best on the TOSCA within-class pairs (README, "Correspondence ratio").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SegmentPairOptions {
     /// Algorithm 2 or 3 and their options (default: Algorithm 2 at a 10 % area cutoff,
