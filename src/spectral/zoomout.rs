@@ -390,9 +390,10 @@ fn nearest_candidates(base: &Mat<f64>, query: MatRef<'_, f64>, count: usize) -> 
                 let col = dots.col(j);
                 best.clear();
                 // `‖a‖² − 2 a·q` orders the rows as the squared distance does; `‖q‖²` is added
-                // to the kept ones only.
+                // to the kept ones only. A NaN (never from a valid spectrum) ranks last.
                 for (i, &norm) in norms.iter().enumerate() {
                     let d = norm - 2.0 * col[i];
+                    let d = if d.is_nan() { f64::INFINITY } else { d };
                     if best.len() < count || d < best[count - 1].0 {
                         let at = best.partition_point(|x| x.0 <= d);
                         best.insert(at, (d, i as u32));
