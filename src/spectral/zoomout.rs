@@ -66,7 +66,8 @@ pub enum FinalMatch {
 impl Default for FinalMatch {
     /// `Bijective` with 64 candidates and [`AuctionOptions::default`]: on the TOSCA
     /// within-class pairs it places the map step's boundaries 0.4–1 point of correspondence
-    /// ratio better than `Nearest` (README), for about 0.3 s on 10,000 vertices.
+    /// ratio better than `Nearest` (README), for 0.3–0.5 s more on 10,000 vertices
+    /// (`examples/bench_zoomout.rs`).
     fn default() -> Self {
         FinalMatch::Bijective {
             candidates: 64,
