@@ -511,45 +511,31 @@ mod zoomout_map {
                 }
             })
             .collect();
-        let map = zoomout(
-            ShapeGeometry {
-                spectrum: &sa,
-                positions: a.positions(),
-                descriptors: None,
-            },
-            ShapeGeometry {
-                spectrum: &sb,
-                positions: b.positions(),
-                descriptors: None,
-            },
-            &start,
-            &options(),
-        )
-        .unwrap();
+        let ga = ShapeGeometry {
+            spectrum: &sa,
+            positions: a.positions(),
+            descriptors: None,
+        };
+        let gb = ShapeGeometry {
+            spectrum: &sb,
+            positions: b.positions(),
+            descriptors: None,
+        };
+        let run = |final_match: FinalMatch| {
+            let options = ZoomOutOptions {
+                final_match,
+                ..options()
+            };
+            zoomout(ga, gb, &start, &options).unwrap()
+        };
+        let map = run(FinalMatch::default());
         let (exact_before, mean_before) = accuracy(&a, &start, &perm);
         let (exact_after, mean_after) = accuracy(&a, &map, &perm);
         eprintln!(
             "exact {exact_before} -> {exact_after} of {}, mean error {mean_before:.4} -> {mean_after:.4}",
             perm.len()
         );
-        let nearest = zoomout(
-            ShapeGeometry {
-                spectrum: &sa,
-                positions: a.positions(),
-                descriptors: None,
-            },
-            ShapeGeometry {
-                spectrum: &sb,
-                positions: b.positions(),
-                descriptors: None,
-            },
-            &start,
-            &ZoomOutOptions {
-                final_match: FinalMatch::Nearest,
-                ..options()
-            },
-        )
-        .unwrap();
+        let nearest = run(FinalMatch::Nearest);
         let (exact_nearest, mean_nearest) = accuracy(&a, &nearest, &perm);
         let distinct = |m: &[u32]| m.iter().collect::<std::collections::BTreeSet<_>>().len();
         eprintln!(
