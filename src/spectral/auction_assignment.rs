@@ -73,7 +73,7 @@ pub struct Assignment {
 /// preimage wherever an embedding is compressed; a true correspondence between two
 /// samplings of one surface is (near) one-to-one, so asking for it moves the crowded matches
 /// to their free second-best neighbours. On the TOSCA within-class pairs this lifts the map
-/// step by 0.4–1 point of correspondence ratio (README).
+/// step by 0.4–1.05 points of correspondence ratio (README).
 ///
 /// Sequential and deterministic (queries bid in index order, first-in first-out; ties go to
 /// the earlier candidate). Terminates: every bid raises a price by at least `ε`, and no

@@ -65,7 +65,7 @@ pub enum FinalMatch {
 
 impl Default for FinalMatch {
     /// `Bijective` with 64 candidates and [`AuctionOptions::default`]: on the TOSCA
-    /// within-class pairs it places the map step's boundaries 0.4–1 point of correspondence
+    /// within-class pairs it places the map step's boundaries 0.4–1.05 points of correspondence
     /// ratio better than `Nearest` (README), for 0.3–0.5 s more on 10,000 vertices
     /// (`examples/bench_zoomout.rs`).
     fn default() -> Self {
