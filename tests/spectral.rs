@@ -467,6 +467,14 @@ mod zoomout_map {
         (a, b, perm, sa, sb)
     }
 
+    fn geometry<'a>(spectrum: &'a Spectrum, mesh: &'a TriMesh) -> ShapeGeometry<'a> {
+        ShapeGeometry {
+            spectrum,
+            positions: mesh.positions(),
+            descriptors: None,
+        }
+    }
+
     /// Vertices mapped to their true image, and the mean distance to it.
     fn accuracy(a: &TriMesh, map: &[u32], perm: &[usize]) -> (usize, f64) {
         let pos = a.positions();
@@ -511,16 +519,7 @@ mod zoomout_map {
                 }
             })
             .collect();
-        let ga = ShapeGeometry {
-            spectrum: &sa,
-            positions: a.positions(),
-            descriptors: None,
-        };
-        let gb = ShapeGeometry {
-            spectrum: &sb,
-            positions: b.positions(),
-            descriptors: None,
-        };
+        let (ga, gb) = (geometry(&sa, &a), geometry(&sb, &b));
         let run = |final_match: FinalMatch| {
             let options = ZoomOutOptions {
                 final_match,
@@ -562,16 +561,7 @@ mod zoomout_map {
     #[test]
     fn zoomout_validates_its_input_and_ignores_the_thread_count() {
         let (a, b, perm, sa, sb) = permuted_pair();
-        let ga = ShapeGeometry {
-            spectrum: &sa,
-            positions: a.positions(),
-            descriptors: None,
-        };
-        let gb = ShapeGeometry {
-            spectrum: &sb,
-            positions: b.positions(),
-            descriptors: None,
-        };
+        let (ga, gb) = (geometry(&sa, &a), geometry(&sb, &b));
         let truth: Vec<u32> = perm.iter().map(|&o| o as u32).collect();
         let first = zoomout(ga, gb, &truth, &options()).unwrap();
         let pool = rayon::ThreadPoolBuilder::new()
@@ -590,6 +580,14 @@ mod zoomout_map {
         sizes.initial_size = 6;
         sizes.step = 0;
         assert!(zoomout(ga, gb, &truth, &sizes).is_err());
+        let no_candidates = ZoomOutOptions {
+            final_match: FinalMatch::Bijective {
+                candidates: 0,
+                auction: Default::default(),
+            },
+            ..options()
+        };
+        assert!(zoomout(ga, gb, &truth, &no_candidates).is_err());
         let short = ShapeGeometry {
             positions: &b.positions()[1..],
             ..gb

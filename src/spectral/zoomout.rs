@@ -190,6 +190,14 @@ pub(crate) fn validate(
             options.descriptor_weight
         )));
     }
+    if matches!(
+        options.final_match,
+        FinalMatch::Bijective { candidates: 0, .. }
+    ) {
+        return Err(SpectralError::InvalidOption(
+            "a bijective final match needs at least 1 candidate".into(),
+        ));
+    }
     let available = a.spectrum.len().min(b.spectrum.len());
     let final_size = options.final_size.min(available);
     if options.initial_size == 0 || options.step == 0 || options.initial_size > final_size {
@@ -251,11 +259,6 @@ fn final_point_map(
             candidates,
             auction,
         } => {
-            if *candidates == 0 {
-                return Err(SpectralError::InvalidOption(
-                    "a bijective final match needs at least 1 candidate".into(),
-                ));
-            }
             let lists = nearest_candidates(base, query, *candidates);
             Ok(auction_assignment(&lists, base.nrows(), auction)?.map)
         }
