@@ -18,6 +18,7 @@
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
 //! | output | [`output`] | region files, coloured meshes, summaries |
+//! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
 #![deny(missing_docs)]
@@ -29,6 +30,7 @@ pub mod evaluate;
 pub mod features;
 pub mod generate;
 pub mod graph;
+pub mod labels;
 pub mod mesh;
 pub mod output;
 pub mod pipeline;
