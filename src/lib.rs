@@ -13,6 +13,7 @@
 //! | spectrum | [`spectral`] | cotangent Laplacian, lumped mass, Laplace–Beltrami eigenpairs |
 //! | features | [`features`] | HKS, WKS and multiscale mean curvature per vertex |
 //! | bands | [`bands`] | per-feature rank bands stored as a compact `u8` table |
+//! | per-shape pipeline | [`pipeline`] | mesh → spectrum → features → bands once per shape, through [`cache`] (storage only); [`pipeline::load_shape`] is the one loader |
 //! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
@@ -30,5 +31,6 @@ pub mod generate;
 pub mod graph;
 pub mod mesh;
 pub mod output;
+pub mod pipeline;
 pub mod spectral;
 pub mod stable;
