@@ -33,7 +33,9 @@
 use crate::bands::{BandError, BandOptions, BandTable, band_table};
 use crate::features::{DescriptorOptions, Descriptors, FeatureError, descriptors};
 use crate::mesh::{TriMesh, write_atomic};
-use crate::spectral::{SpectralError, Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
+use crate::spectral::{
+    SpectralError, Spectrum, SpectrumOptions, available_eigenpairs, laplace_beltrami_spectrum,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
@@ -242,8 +244,31 @@ pub fn compute_shape_data(
     mesh: &TriMesh,
     options: &ShapePipelineOptions,
 ) -> Result<ShapeData, PipelineError> {
-    let spectrum = laplace_beltrami_spectrum(mesh, &options.spectrum)?;
+    let mut spectrum_options = options.spectrum.clone();
+    spectrum_options.eigenpairs = spectrum_options.eigenpairs.min(available_eigenpairs(mesh));
+    let spectrum = laplace_beltrami_spectrum(mesh, &spectrum_options)?;
     shape_data_from_spectrum(mesh, spectrum, options)
+}
+
+/// The warning for a mesh with fewer usable vertices than the eigenpairs `options` ask for
+/// (see [`crate::spectral::available_eigenpairs`]): [`compute_shape_data`] then computes as
+/// many eigenpairs as the mesh has, and every later stage works with that many. `None` when
+/// the mesh is large enough.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, cache::{small_mesh_warning, ShapePipelineOptions}};
+/// let m = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
+/// let w = small_mesh_warning(&m, &ShapePipelineOptions::default()).unwrap();
+/// assert!(w.contains("3 of the 200 eigenpairs"), "{w}");
+/// ```
+pub fn small_mesh_warning(mesh: &TriMesh, options: &ShapePipelineOptions) -> Option<String> {
+    let available = available_eigenpairs(mesh);
+    let asked = options.spectrum.eigenpairs;
+    (available < asked).then(|| {
+        format!(
+            "{available} vertices carry area: computing {available} of the {asked} eigenpairs asked for"
+        )
+    })
 }
 
 /// Descriptors and band table from an already computed spectrum (e.g. read elsewhere), keyed
@@ -406,8 +431,25 @@ pub fn encode_bands_entry(data: &ShapeBands) -> Vec<u8> {
     frame(BANDS_MAGIC, &data.key, payload)
 }
 
-/// Verifies and decodes a compact bands entry; `Err` says why it cannot be trusted.
-fn decode_bands_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeBands, String> {
+/// Verifies and decodes the bytes of a compact bands entry written for `key` on a mesh of
+/// `vertices` vertices; `Err` says why it cannot be trusted (truncated, bad magic, stale
+/// version or key, checksum mismatch, payload that does not decode, sizes that do not match,
+/// labels out of range, non-finite areas). Never panics, whatever the bytes.
+///
+/// ```
+/// use coseg::cache::{decode_bands_entry, encode_bands_entry, ShapeBands, ShapeKey};
+/// use coseg::bands::equal_count_bands;
+/// let bands = equal_count_bands(&[0.0, 1.0, 2.0], 1, 3, 2).unwrap();
+/// let data = ShapeBands { key: ShapeKey([7; 32]), bands, vertex_areas: vec![1.0 / 3.0; 3] };
+/// let bytes = encode_bands_entry(&data);
+/// assert_eq!(decode_bands_entry(&bytes, &data.key, 3).unwrap(), data);
+/// assert!(decode_bands_entry(&bytes[..bytes.len() - 1], &data.key, 3).is_err());
+/// ```
+pub fn decode_bands_entry(
+    bytes: &[u8],
+    key: &ShapeKey,
+    vertices: usize,
+) -> Result<ShapeBands, String> {
     let payload = unframe(bytes, BANDS_MAGIC, key)?;
     let (data, used): (ShapeBands, usize) =
         bincode::serde::decode_from_slice(payload, bincode::config::standard())
@@ -426,9 +468,11 @@ fn decode_bands_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<S
     if !consistent {
         return Err("payload sizes do not match the mesh".into());
     }
+    if !data.vertex_areas.iter().all(|a| a.is_finite()) {
+        return Err("payload holds non-finite vertex areas".into());
+    }
     Ok(data)
 }
-
 /// `magic | format version | key | payload length | BLAKE3 of payload | payload`.
 fn frame(magic: &[u8; 8], key: &ShapeKey, payload: Vec<u8>) -> Vec<u8> {
     let mut out = Vec::with_capacity(HEADER_LEN + payload.len());
@@ -479,8 +523,24 @@ pub fn encode_entry(data: &ShapeData) -> Vec<u8> {
     frame(MAGIC, &data.key, payload)
 }
 
-/// Verifies and decodes a cache entry; `Err` says why it cannot be trusted.
-fn decode_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeData, String> {
+/// Verifies and decodes the bytes of a full cache entry written for `key` on a mesh of
+/// `vertices` vertices; `Err` says why it cannot be trusted (truncated, bad magic, stale
+/// version or key, checksum mismatch, payload that does not decode, sizes that do not match,
+/// non-finite numbers). Never panics, whatever the bytes.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, cache::{compute_shape_data, decode_entry, encode_entry, ShapePipelineOptions}};
+/// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
+/// let mut o = ShapePipelineOptions::default();
+/// o.spectrum.eigenpairs = 4;
+/// o.bands.bands = 2;
+/// let data = compute_shape_data(&m, &o).unwrap();
+/// let mut bytes = encode_entry(&data);
+/// assert_eq!(decode_entry(&bytes, &data.key, 4).unwrap(), data);
+/// *bytes.last_mut().unwrap() ^= 1; // one flipped bit: the checksum no longer matches
+/// assert!(decode_entry(&bytes, &data.key, 4).unwrap_err().contains("checksum"));
+/// ```
+pub fn decode_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeData, String> {
     let payload = unframe(bytes, MAGIC, key)?;
     let (data, used): (ShapeData, usize) =
         bincode::serde::decode_from_slice(payload, bincode::config::standard())
@@ -499,9 +559,25 @@ fn decode_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeDa
         && data.descriptors.values.len() == n * vertices
         && data.bands.vertices == vertices
         && data.bands.features == n
-        && data.bands.labels.len() == n * vertices;
+        && data.bands.labels.len() == n * vertices
+        && data.spectrum.vertex_areas.len() == vertices
+        && data.descriptors.vertex_areas.len() == vertices
+        && data
+            .bands
+            .labels
+            .iter()
+            .all(|&l| (l as usize) < data.bands.bands);
     if !consistent {
         return Err("payload sizes do not match the mesh".into());
+    }
+    let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+    if !(finite(&data.spectrum.eigenvalues)
+        && finite(&data.spectrum.eigenvectors)
+        && finite(&data.spectrum.vertex_areas)
+        && finite(&data.descriptors.values)
+        && finite(&data.descriptors.vertex_areas))
+    {
+        return Err("payload holds non-finite numbers".into());
     }
     Ok(data)
 }

@@ -135,6 +135,9 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         for w in &report.warnings {
             eprintln!("warning: {}: {w}", path.display());
         }
+        if let Some(w) = coseg::cache::small_mesh_warning(&mesh, &pipe) {
+            eprintln!("warning: {}: {w}", path.display());
+        }
         let data = match &args.cache {
             Some(dir) => {
                 let r = load_or_compute(&mesh, &pipe, dir)
@@ -213,7 +216,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         map_guided,
     };
     let t = Instant::now();
-    let regions = segment_pair(
+    let pair = segment_pair(
         PairShape {
             mesh: ma,
             spectrum: &da.spectrum,
@@ -228,8 +231,11 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         },
         &pair_options,
     )
-    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?
-    .regions;
+    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
+    for f in &pair.fallbacks {
+        eprintln!("warning: {} x {}: {f}", args.a.display(), args.b.display());
+    }
+    let regions = pair.regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
@@ -266,7 +272,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     .with_map_preset(pair_options.map_guided.as_ref().map(|_| PresetChoice {
         preset: chosen,
         discrepancy: choice.discrepancy,
-    }));
+    }))
+    .with_fallbacks(pair.fallbacks);
     let shapes = [
         ShapeRegions {
             name: &na,

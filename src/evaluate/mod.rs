@@ -36,7 +36,7 @@ pub use ground_truth::GroundTruth;
 pub use group_parts::{PartGroups, group_parts};
 pub use part_coverage::part_coverage;
 pub use part_purity::part_purity;
-pub use read_labels::read_labels;
+pub use read_labels::{parse_labels, read_labels};
 
 use crate::mesh::TriMesh;
 use std::collections::BTreeMap;
