@@ -334,12 +334,11 @@ pub fn load_or_compute(
         },
     };
     let data = compute_shape_data(mesh, options)?;
-    std::fs::create_dir_all(cache_dir).map_err(|source| PipelineError::Io {
-        path: cache_dir.display().to_string(),
-        source,
-    })?;
+    // A cache that cannot be written (read-only, full, not a folder) costs a recomputation
+    // next time, not this run: the data are returned with a warning.
     let entry = encode_entry(&data);
-    let write_error = write_atomic(&path, |w| w.write_all(&entry))
+    let write_error = std::fs::create_dir_all(cache_dir)
+        .and_then(|()| write_atomic(&path, |w| w.write_all(&entry)))
         .err()
         .map(|e| format!("{}: cache entry not written: {e}", path.display()));
     Ok(CacheResult {
