@@ -484,3 +484,57 @@ fn a_missing_file_is_reported_once() {
         );
     }
 }
+
+/// An optional stage that cannot run leaves the previous stage's regions and says why: here
+/// the map step gets shapes carrying different descriptor counts (its validation rejects
+/// them), and the result is exactly the run without the map step.
+#[test]
+fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run() {
+    use coseg::cache::{ShapePipelineOptions, compute_shape_data};
+    use coseg::stable::{PairShape, PairStage, SegmentPairOptions, segment_pair};
+    let mut pipe = ShapePipelineOptions::default();
+    pipe.spectrum.eigenpairs = 40;
+    pipe.descriptors.hks_count = 8;
+    pipe.descriptors.wks_count = 8;
+    pipe.descriptors.curvature_count = 8;
+    pipe.bands.bands = 6;
+    let meshes: Vec<TriMesh> = [1, 2]
+        .iter()
+        .map(|&s| {
+            let (p, f) = base_sphere(s);
+            TriMesh::new(p, f).unwrap()
+        })
+        .collect();
+    let data: Vec<_> = meshes
+        .iter()
+        .map(|m| compute_shape_data(m, &pipe).unwrap())
+        .collect();
+    let d = meshes[1].vertex_count();
+    let b_values = &data[1].descriptors.values;
+    // B loses its last descriptor column.
+    let descriptors = [&data[0].descriptors.values[..], &b_values[..b_values.len() - d]];
+    let shape = |i: usize| PairShape {
+        mesh: &meshes[i],
+        spectrum: &data[i].spectrum,
+        bands: &data[i].bands,
+        descriptors: Some(descriptors[i]),
+    };
+    let mut options = SegmentPairOptions::default();
+    options.map_guided.as_mut().unwrap().point_map.zoomout.final_size = 40;
+    let out = segment_pair(shape(0), shape(1), &options).unwrap();
+    assert_eq!(out.fallbacks.len(), 1, "{:?}", out.fallbacks);
+    assert_eq!(out.fallbacks[0].stage, PairStage::MapGuided);
+    assert!(out.fallbacks[0].reason.contains("descriptors"), "{}", out.fallbacks[0]);
+    let without = SegmentPairOptions {
+        map_guided: None,
+        ..options.clone()
+    };
+    let reference = segment_pair(shape(0), shape(1), &without).unwrap();
+    assert!(reference.fallbacks.is_empty());
+    assert_eq!(out.regions.labels_b(), reference.regions.labels_b());
+    assert_eq!(out.regions.labels_a(), reference.regions.labels_a());
+    // A wrong option is still the caller's error, not a fallback.
+    let mut bad = options;
+    bad.map_guided.as_mut().unwrap().map_weight = f64::NAN;
+    assert!(segment_pair(shape(0), shape(1), &bad).is_err());
+}
