@@ -490,7 +490,7 @@ fn a_missing_file_is_reported_once() {
 /// them), and the result is exactly the run without the map step.
 #[test]
 fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run() {
-    use coseg::cache::{ShapePipelineOptions, compute_shape_data};
+    use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
     use coseg::stable::{PairShape, PairStage, SegmentPairOptions, segment_pair};
     let mut pipe = ShapePipelineOptions::default();
     pipe.spectrum.eigenpairs = 40;
@@ -512,7 +512,10 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
     let d = meshes[1].vertex_count();
     let b_values = &data[1].descriptors.values;
     // B loses its last descriptor column.
-    let descriptors = [&data[0].descriptors.values[..], &b_values[..b_values.len() - d]];
+    let descriptors = [
+        &data[0].descriptors.values[..],
+        &b_values[..b_values.len() - d],
+    ];
     let shape = |i: usize| PairShape {
         mesh: &meshes[i],
         spectrum: &data[i].spectrum,
@@ -520,11 +523,21 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
         descriptors: Some(descriptors[i]),
     };
     let mut options = SegmentPairOptions::default();
-    options.map_guided.as_mut().unwrap().point_map.zoomout.final_size = 40;
+    options
+        .map_guided
+        .as_mut()
+        .unwrap()
+        .point_map
+        .zoomout
+        .final_size = 40;
     let out = segment_pair(shape(0), shape(1), &options).unwrap();
     assert_eq!(out.fallbacks.len(), 1, "{:?}", out.fallbacks);
     assert_eq!(out.fallbacks[0].stage, PairStage::MapGuided);
-    assert!(out.fallbacks[0].reason.contains("descriptors"), "{}", out.fallbacks[0]);
+    assert!(
+        out.fallbacks[0].reason.contains("descriptors"),
+        "{}",
+        out.fallbacks[0]
+    );
     let without = SegmentPairOptions {
         map_guided: None,
         ..options.clone()

@@ -111,7 +111,7 @@ fn truncated_and_tampered_entries_are_never_trusted() {
     let nan_entry = {
         let mut data = fresh.data.clone();
         data.descriptors.values[3] = f64::NAN;
-        encode_entry(&data)
+        encode_shape_entry(&data)
     };
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![
         ("empty", Vec::new(), "truncated header"),
@@ -170,7 +170,7 @@ fn truncated_and_tampered_entries_are_never_trusted() {
         ("NaN behind a valid checksum", nan_entry, "non-finite"),
     ];
     for (what, bytes, reason) in cases {
-        let err = decode_entry(&bytes, &key, mesh.vertex_count()).unwrap_err();
+        let err = decode_shape_entry(&bytes, &key, mesh.vertex_count()).unwrap_err();
         assert!(err.contains(reason), "{what}: {err}");
         std::fs::write(&fresh.path, &bytes).unwrap();
         let r = load_or_compute(&mesh, &o, &dir).unwrap();

@@ -3,10 +3,12 @@
 //! bytes, so the fuzzer reaches the payload decoder and the consistency checks instead of
 //! stopping at the checksum. The first payload bytes decode as the entry's key, so they are
 //! also taken as the expected key. Byte 0 picks the entry kind (full or compact) and the
-//! expected vertex count. Whatever decodes must be fully consistent and finite.
+//! expected vertex count. Whatever decodes must be fully consistent and finite
+//! (`coseg::pipeline::decode_shape_entry`, `decode_bands_entry`).
 #![no_main]
 
-use coseg::cache::{FORMAT_VERSION, ShapeKey, decode_bands_entry, decode_entry};
+use coseg::cache::{FORMAT_VERSION, ShapeKey};
+use coseg::pipeline::{decode_bands_entry, decode_shape_entry};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
@@ -27,7 +29,7 @@ fuzz_target!(|data: &[u8]| {
     bytes.extend_from_slice(payload);
     let vertices = (pick >> 1) as usize;
     if pick & 1 == 0 {
-        if let Ok(d) = decode_entry(&bytes, &key, vertices) {
+        if let Ok(d) = decode_shape_entry(&bytes, &key, vertices) {
             assert_eq!(d.vertices, vertices);
             assert!(d.descriptors.values.iter().all(|x| x.is_finite()));
         }

@@ -2,9 +2,8 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
-use coseg::mesh::read_mesh_with_report;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
+use coseg::pipeline::{PipelineError, ShapeData, load_shape};
 use coseg::spectral::ZoomOutOptions;
 use coseg::stable::{
     Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY,
@@ -131,30 +130,15 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     let pipe = args.pipeline.options();
     let mut loaded = Vec::new();
     for path in [&args.a, &args.b] {
-        let (mesh, report) = read_mesh_with_report(path)?;
-        for w in &report.warnings {
-            eprintln!("warning: {}: {w}", path.display());
-        }
-        if let Some(w) = coseg::cache::small_mesh_warning(&mesh, &pipe) {
-            eprintln!("warning: {}: {w}", path.display());
-        }
-        let data = match &args.cache {
-            Some(dir) => {
-                let r = load_or_compute(&mesh, &pipe, dir)
-                    .with_context(|| format!("{}", path.display()))?;
-                if let CacheOutcome::Recomputed { reason } = &r.outcome {
-                    eprintln!("warning: {reason}");
-                }
-                if let Some(e) = &r.write_error {
-                    eprintln!("warning: {e}");
-                }
-                r.data
-            }
-            None => {
-                compute_shape_data(&mesh, &pipe).with_context(|| format!("{}", path.display()))?
-            }
+        let shape = match load_shape::<ShapeData>(path, &pipe, args.cache.as_deref()) {
+            Ok(s) => s,
+            Err(PipelineError::Mesh(e)) => return Err(e.into()),
+            Err(e) => return Err(anyhow::Error::new(e).context(format!("{}", path.display()))),
         };
-        loaded.push((mesh, data));
+        for w in &shape.warnings {
+            eprintln!("warning: {w}");
+        }
+        loaded.push((shape.mesh, shape.data));
     }
     let options = StableRegionsOptions {
         algorithm: match args.algorithm {

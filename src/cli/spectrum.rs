@@ -52,11 +52,11 @@ pub fn run(args: SpectrumArgs) -> Result<ExitCode> {
         basis_size: args.basis_size,
         ..SpectrumOptions::default()
     };
-    let pipeline = coseg::cache::ShapePipelineOptions {
+    let pipeline = coseg::pipeline::ShapePipelineOptions {
         spectrum: options.clone(),
         ..Default::default()
     };
-    if let Some(w) = coseg::cache::small_mesh_warning(&mesh, &pipeline) {
+    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &pipeline) {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
     let options = SpectrumOptions {

@@ -16,8 +16,10 @@
 //! The common call is [`descriptors`] with [`DescriptorOptions::default`] (100 HKS + 100 WKS +
 //! 100 mean-curvature scales, as in the paper).
 
+mod columns;
 mod descriptors;
 mod export;
+mod extrinsic;
 mod heat_kernel_signature;
 mod mean_curvature;
 mod multiscale_mean_curvature;
@@ -25,8 +27,12 @@ mod scale_grid;
 mod spectral_product;
 mod wave_kernel_signature;
 
+pub use columns::FeatureColumns;
 pub use descriptors::{DescriptorOptions, Descriptors, FeatureKind, descriptors};
 pub use export::{ExportFormat, ExportOptions, export_features};
+pub use extrinsic::{
+    Alignment, Axis, ExtrinsicOptions, Frame, extrinsic_features, height_directions, shape_frame,
+};
 pub use heat_kernel_signature::heat_kernel_signature;
 pub use mean_curvature::mean_curvature;
 pub use multiscale_mean_curvature::multiscale_mean_curvature;
@@ -52,6 +58,9 @@ pub enum FeatureError {
     /// A scale option is out of range (non-positive or non-finite bound, empty range…).
     #[error("invalid scale option: {0}")]
     BadScale(String),
+    /// An option of a feature family is invalid.
+    #[error("invalid feature option: {0}")]
+    BadOption(String),
     /// A file could not be written.
     #[error("{path}: {source}")]
     Io {

@@ -10,12 +10,13 @@
 //!   with `_2`, `_3`… appended should that still collide), with a warning ([`shape_names`]).
 
 use super::{GraphError, ShapeNode};
-use crate::cache::{CacheOutcome, ShapePipelineOptions, load_or_compute_bands};
-use crate::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
+use crate::cache::CacheOutcome;
+use crate::mesh::{MeshFormat, TriMesh};
+use crate::pipeline::{PipelineError, ShapeBands, ShapePipelineOptions, load_shape};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// A file that could not be used, and why (the message names the file).
 #[derive(Debug, Clone, PartialEq)]
@@ -150,7 +151,8 @@ pub fn shape_names(paths: &[PathBuf]) -> (Vec<String>, Vec<String>) {
 }
 
 /// Reads every mesh file of `folder` ([`mesh_files`]) and gets its band table through the
-/// per-shape cache in `cache_dir` ([`crate::cache::load_or_compute_bands`]: only the band
+/// per-shape cache in `cache_dir` ([`crate::pipeline::load_shape`] of
+/// [`crate::pipeline::ShapeBands`]: only the band
 /// tables and vertex areas are read when the cache is warm). Shapes are processed in
 /// parallel on rayon's pool (one shape per thread: the per-shape work is independent, so the
 /// result is the same whatever the thread count); the result keeps file order. Files that fail
@@ -160,7 +162,7 @@ pub fn shape_names(paths: &[PathBuf]) -> (Vec<String>, Vec<String>) {
 /// the module docs).
 ///
 /// ```no_run
-/// use coseg::cache::ShapePipelineOptions;
+/// use coseg::pipeline::ShapePipelineOptions;
 /// use coseg::graph::load_collection;
 /// use std::path::Path;
 /// let c = load_collection(Path::new("shapes"), &ShapePipelineOptions::default(),
@@ -261,35 +263,24 @@ fn load_one(
             error,
         })
     };
-    let t = Instant::now();
-    let read = read_mesh_with_report(&path);
-    r.read_time = t.elapsed();
-    let (mesh, report) = match read {
+    let res = match load_shape::<ShapeBands>(&path, options, Some(cache_dir)) {
         Ok(x) => x,
-        Err(e) => {
+        Err(PipelineError::Mesh(e)) => {
             r.outcome = skip(e.to_string());
             return r;
         }
-    };
-    for w in &report.warnings {
-        r.warnings.push(format!("{}: {w}", path.display()));
-    }
-    if let Some(w) = crate::cache::small_mesh_warning(&mesh, options) {
-        r.warnings.push(format!("{}: {w}", path.display()));
-    }
-    let t = Instant::now();
-    let data = load_or_compute_bands(&mesh, options, cache_dir);
-    r.shape_time = t.elapsed();
-    let res = match data {
-        Ok(x) => x,
         Err(e) => {
             r.outcome = skip(format!("{}: {e}", path.display()));
             return r;
         }
     };
-    r.warnings.extend(res.warnings);
+    r.read_time = res.read_time;
+    r.shape_time = res.shape_time;
+    r.warnings = res.warnings;
+    let outcome = res.outcome.unwrap_or(CacheOutcome::Miss);
+    let mesh = res.mesh;
     r.outcome = match ShapeNode::new(name, res.data.bands, &res.data.vertex_areas) {
-        Ok(node) => Ok((mesh, node, res.outcome)),
+        Ok(node) => Ok((mesh, node, outcome)),
         Err(e) => skip(format!("{}: {e}", path.display())),
     };
     r

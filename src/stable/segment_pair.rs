@@ -40,7 +40,7 @@ impl Default for SegmentPairOptions {
 }
 
 /// One shape as [`segment_pair`] needs it: the mesh, and the spectrum and band table computed
-/// from it (e.g. [`compute_shape_data`](crate::cache::compute_shape_data)).
+/// from it (e.g. [`compute_shape_data`](crate::pipeline::compute_shape_data)).
 #[derive(Debug, Clone, Copy)]
 pub struct PairShape<'a> {
     /// The mesh (vertex areas, positions, and the heat smoothers' Laplacian).
@@ -102,7 +102,7 @@ pub struct SegmentedPair {
 ///
 /// ```no_run
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
-/// use coseg::cache::{compute_shape_data, ShapePipelineOptions};
+/// use coseg::pipeline::{compute_shape_data, ShapePipelineOptions};
 /// use coseg::mesh::read_mesh;
 /// use coseg::stable::{segment_pair, PairShape, SegmentPairOptions};
 /// let (ma, mb) = (read_mesh("cat0.off")?, read_mesh("cat1.off")?);
