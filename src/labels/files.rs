@@ -121,7 +121,10 @@ pub fn read_shape_labels(
         LabelKind::Vertex => file_labels.clone(),
         LabelKind::Face => faces_to_vertices(mesh, &file_labels)?,
     };
-    vertex_labels.iter_mut().filter(|l| **l < 0).for_each(|l| *l = -1);
+    vertex_labels
+        .iter_mut()
+        .filter(|l| **l < 0)
+        .for_each(|l| *l = -1);
     Ok(ShapeLabels {
         path: path.to_path_buf(),
         kind,
@@ -146,7 +149,9 @@ pub fn label_file_stem(path: &Path) -> Option<String> {
             return Some(name[..name.len() - suffix.len()].to_string());
         }
     }
-    path.file_stem().and_then(|s| s.to_str()).map(str::to_string)
+    path.file_stem()
+        .and_then(|s| s.to_str())
+        .map(str::to_string)
 }
 
 fn is_label_file(path: &Path) -> bool {
