@@ -1,8 +1,7 @@
 //! [`PairSummary`]: the `summary.json` of a two-shape stable-region run.
 
-use crate::stable::{
-    MapGuidedOptions, PresetChoice, RefineOptions, StableRegions, StableRegionsOptions,
-};
+use crate::maps::PresetChoice;
+use crate::stable::{MapGuidedOptions, RefineOptions, StableRegions, StableRegionsOptions};
 use serde::Serialize;
 
 /// One shape of a pair run.
@@ -55,7 +54,7 @@ pub struct PairSummary {
     /// [`map_guided_refinement`](crate::stable::map_guided_refinement)).
     pub map_guided: Option<MapGuidedOptions>,
     /// Which preset the map step's options came from and the pair's eigenvalue discrepancy
-    /// (see [`map_preset`](crate::stable::map_preset)), when the step ran.
+    /// (see [`map_preset`](crate::maps::map_preset)), when the step ran.
     pub map_preset: Option<PresetChoice>,
     /// Per-region statistics, in region-id order.
     pub regions: Vec<RegionSummary>,
