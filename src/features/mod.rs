@@ -24,7 +24,9 @@ mod heat_kernel_signature;
 mod mean_curvature;
 mod multiscale_mean_curvature;
 mod scale_grid;
+mod sdf;
 mod spectral_product;
+mod user;
 mod wave_kernel_signature;
 
 pub use columns::FeatureColumns;
@@ -37,6 +39,8 @@ pub use heat_kernel_signature::heat_kernel_signature;
 pub use mean_curvature::mean_curvature;
 pub use multiscale_mean_curvature::multiscale_mean_curvature;
 pub use scale_grid::{ScaleGrid, SpectralBand, scale_grid};
+pub use sdf::{SdfOptions, shape_diameter};
+pub use user::{read_user_features, user_feature_path};
 pub use wave_kernel_signature::wave_kernel_signature;
 
 use thiserror::Error;
@@ -61,6 +65,14 @@ pub enum FeatureError {
     /// An option of a feature family is invalid.
     #[error("invalid feature option: {0}")]
     BadOption(String),
+    /// A user feature file is missing, unreadable or malformed.
+    #[error("{path}: {message}")]
+    UserFile {
+        /// The file concerned.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A file could not be written.
     #[error("{path}: {source}")]
     Io {
