@@ -12,6 +12,7 @@ mod eigenvalue_discrepancy;
 mod heat_smoother;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
+mod nearest_rows;
 mod shift_invert;
 pub(crate) mod zoomout;
 
