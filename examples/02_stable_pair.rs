@@ -13,9 +13,9 @@
 //! (left/right legs merged: an intrinsic method cannot tell mirror images apart).
 
 use coseg::affinity::BandAffinity;
-use coseg::cache::{ShapePipelineOptions, compute_shape_data};
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
 use coseg::mesh::read_mesh;
+use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
 use coseg::spectral::HeatSmoother;
 use coseg::stable::{
     PairShape, RefineOptions, SegmentPairOptions, ShapeGeometry, StableRegions,

@@ -19,8 +19,8 @@
 
 use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
-use coseg::cache::{ShapeData, ShapePipelineOptions, load_or_compute};
 use coseg::mesh::{TriMesh, read_mesh};
+use coseg::pipeline::{ShapeData, ShapePipelineOptions, load_or_compute};
 use coseg::spectral::{FinalMatch, HeatSmoother, ZoomOutOptions, zoomout};
 use coseg::stable::{
     Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, PairShape, RefineOptions,

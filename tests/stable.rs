@@ -795,8 +795,8 @@ fn refine_regions_rebuilds_pairs_with_dense_objectives() {
 mod map_guided {
     use super::common::features::{blob, permutation, permute_mesh};
     use coseg::affinity::{BandAffinity, Direction};
-    use coseg::cache::{ShapeData, ShapePipelineOptions, compute_shape_data};
     use coseg::mesh::TriMesh;
+    use coseg::pipeline::{ShapeData, ShapePipelineOptions, compute_shape_data};
     use coseg::spectral::HeatSmoother;
     use coseg::spectral::ZoomOutOptions;
     use coseg::stable::{

@@ -74,7 +74,7 @@ impl Default for MapGuidedOptions {
 /// ```no_run
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// use coseg::affinity::BandAffinity;
-/// use coseg::cache::{compute_shape_data, ShapePipelineOptions};
+/// use coseg::pipeline::{compute_shape_data, ShapePipelineOptions};
 /// use coseg::mesh::read_mesh;
 /// use coseg::spectral::HeatSmoother;
 /// use coseg::stable::*;

@@ -42,7 +42,9 @@ pub use refine_partition::{
 };
 pub use refine_regions::refine_regions;
 pub use region_point_map::{MapShape, PointMapOptions, region_point_map};
-pub use segment_pair::{PairShape, PairTimes, SegmentPairOptions, SegmentedPair, segment_pair};
+pub use segment_pair::{
+    PairShape, PairStage, PairTimes, SegmentPairOptions, SegmentedPair, StageFallback, segment_pair,
+};
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
 };
