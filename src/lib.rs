@@ -19,6 +19,7 @@
 //! | output | [`output`] | region files, coloured meshes, summaries |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
+//! | per-shape task | [`shape_task`] | the per-shape stage as bytes in, cache entry bytes out (for distributed engines) |
 #![deny(missing_docs)]
 
 pub mod affinity;
@@ -30,5 +31,6 @@ pub mod generate;
 pub mod graph;
 pub mod mesh;
 pub mod output;
+pub mod shape_task;
 pub mod spectral;
 pub mod stable;
