@@ -544,6 +544,12 @@ fn segment<'py>(
     o.finish()?;
     let loaded = if let Ok(list) = shapes.cast::<PyList>() {
         let list = shapes_from(list, names)?;
+        if list.len() < 2 {
+            return Err(input_err(format!(
+                "co-segmentation needs at least 2 readable shapes, got {}",
+                list.len()
+            )));
+        }
         py.detach(|| load_arrays(list, &pipe, cache.as_deref()))
     } else {
         let folder: PathBuf = shapes.extract()?;
