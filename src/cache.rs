@@ -407,7 +407,11 @@ pub fn encode_bands_entry(data: &ShapeBands) -> Vec<u8> {
 }
 
 /// Verifies and decodes a compact bands entry; `Err` says why it cannot be trusted.
-pub(crate) fn decode_bands_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeBands, String> {
+pub(crate) fn decode_bands_entry(
+    bytes: &[u8],
+    key: &ShapeKey,
+    vertices: usize,
+) -> Result<ShapeBands, String> {
     let payload = unframe(bytes, BANDS_MAGIC, key)?;
     let (data, used): (ShapeBands, usize) =
         bincode::serde::decode_from_slice(payload, bincode::config::standard())
@@ -480,7 +484,11 @@ pub fn encode_entry(data: &ShapeData) -> Vec<u8> {
 }
 
 /// Verifies and decodes a cache entry; `Err` says why it cannot be trusted.
-pub(crate) fn decode_entry(bytes: &[u8], key: &ShapeKey, vertices: usize) -> Result<ShapeData, String> {
+pub(crate) fn decode_entry(
+    bytes: &[u8],
+    key: &ShapeKey,
+    vertices: usize,
+) -> Result<ShapeData, String> {
     let payload = unframe(bytes, MAGIC, key)?;
     let (data, used): (ShapeData, usize) =
         bincode::serde::decode_from_slice(payload, bincode::config::standard())
