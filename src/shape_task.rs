@@ -2,16 +2,17 @@
 //!
 //! [`compute_shape_entry`] is what a distributed engine (Dask, Ray, a batch queue) runs on a
 //! worker: it touches no file system and returns the bytes of the two cache entries
-//! ([`crate::cache`]'s full entry and compact bands entry) under the same content key
-//! ([`crate::cache::shape_key`]) that [`crate::cache::load_or_compute`] uses. Whoever collects
+//! ([`crate::pipeline`]'s full entry and compact bands entry) under the same content key
+//! ([`crate::pipeline::shape_key`]) that [`crate::pipeline::load_or_compute`] uses. Whoever collects
 //! the bytes calls [`store_shape_entry`], which verifies them against the mesh's key and writes
 //! them atomically into a cache directory; the collection stage (`coseg segment`,
 //! [`crate::graph::load_collection`]) then finds them warm. [`entry_is_valid`] lets a rerun skip
 //! the shapes that are already done.
 
-use crate::cache::{
-    self, PipelineError, ShapeBands, ShapeKey, ShapePipelineOptions, bands_path, cache_path,
-    compute_shape_data, encode_bands_entry, encode_entry, shape_key,
+use crate::cache::{ShapeKey, bands_path, cache_path};
+use crate::pipeline::{
+    PipelineError, ShapeBands, ShapePipelineOptions, compute_shape_data, decode_bands_entry,
+    decode_shape_entry, encode_bands_entry, encode_shape_entry, shape_key,
 };
 use crate::mesh::{MeshError, MeshFormat, TriMesh, read_mesh_from_bytes, write_atomic};
 use std::io::Write;
@@ -63,7 +64,7 @@ pub struct ShapeEntry {
 /// file) under `options`, without computing anything else. Errors name `<memory>`.
 ///
 /// ```
-/// use coseg::cache::ShapePipelineOptions;
+/// use coseg::pipeline::ShapePipelineOptions;
 /// use coseg::mesh::MeshFormat;
 /// use coseg::shape_task::shape_key_of_bytes;
 /// let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
@@ -81,11 +82,11 @@ pub fn shape_key_of_bytes(
 
 /// The per-shape stage as a pure function: parses `mesh_bytes` (a whole mesh file in
 /// `format`), computes spectrum, descriptors and band table under `options`, and returns the
-/// bytes of the two cache entries, exactly as [`crate::cache::load_or_compute_bands`] would
+/// bytes of the two cache entries, exactly as [`crate::pipeline::load_or_compute_bands`] would
 /// write them. Deterministic: the same bytes and options give the same entry bytes.
 ///
 /// ```
-/// use coseg::cache::ShapePipelineOptions;
+/// use coseg::pipeline::ShapePipelineOptions;
 /// use coseg::mesh::MeshFormat;
 /// use coseg::shape_task::{compute_shape_entry, shape_key_of_bytes};
 /// let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
@@ -114,7 +115,7 @@ pub fn entry_of_mesh(
     Ok(ShapeEntry {
         key: data.key,
         vertices: data.vertices,
-        entry: encode_entry(&data),
+        entry: encode_shape_entry(&data),
         bands_entry: encode_bands_entry(&ShapeBands::of(&data)),
     })
 }
@@ -125,7 +126,8 @@ pub fn entry_of_mesh(
 /// entry first). Nothing is written unless both entries verify.
 ///
 /// ```
-/// use coseg::cache::{ShapePipelineOptions, load_or_compute_bands, CacheOutcome};
+/// use coseg::cache::CacheOutcome;
+/// use coseg::pipeline::{ShapePipelineOptions, load_or_compute_bands};
 /// use coseg::mesh::{MeshFormat, read_mesh_from_bytes};
 /// use coseg::shape_task::{compute_shape_entry, store_shape_entry};
 /// let obj = b"v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n";
@@ -155,8 +157,8 @@ pub fn store_shape_entry(
         path: path.display().to_string(),
         reason,
     };
-    cache::decode_entry(entry, key, vertices).map_err(|r| untrusted(&full, r))?;
-    cache::decode_bands_entry(bands_entry, key, vertices).map_err(|r| untrusted(&compact, r))?;
+    decode_shape_entry(entry, key, vertices).map_err(|r| untrusted(&full, r))?;
+    decode_bands_entry(bands_entry, key, vertices).map_err(|r| untrusted(&compact, r))?;
     std::fs::create_dir_all(cache_dir).map_err(|source| ShapeTaskError::Io {
         path: cache_dir.display().to_string(),
         source,
@@ -182,9 +184,9 @@ pub fn store_shape_entry(
 /// ```
 pub fn entry_is_valid(cache_dir: &Path, key: &ShapeKey, vertices: usize) -> bool {
     let full = std::fs::read(cache_path(cache_dir, key))
-        .is_ok_and(|b| cache::decode_entry(&b, key, vertices).is_ok());
+        .is_ok_and(|b| decode_shape_entry(&b, key, vertices).is_ok());
     full && std::fs::read(bands_path(cache_dir, key))
-        .is_ok_and(|b| cache::decode_bands_entry(&b, key, vertices).is_ok())
+        .is_ok_and(|b| decode_bands_entry(&b, key, vertices).is_ok())
 }
 
 /// Parses a 64-character lower- or upper-case hexadecimal key ([`ShapeKey::to_hex`]'s form).

@@ -5,8 +5,9 @@
 
 mod options;
 
-use coseg::cache::{
-    CacheOutcome, ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
+use coseg::cache::CacheOutcome;
+use coseg::pipeline::{
+    ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
 };
 use coseg::graph::{SegmentCollectionOptions, ShapeNode, load_collection, segment_collection};
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
@@ -15,7 +16,8 @@ use coseg::output::{
 };
 use coseg::shape_task;
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
-use coseg::stable::{PairShape, PresetChoice, segment_pair};
+use coseg::maps::PresetChoice;
+use coseg::stable::{PairShape, segment_pair};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use options::Opts;

@@ -3,13 +3,13 @@
 //! unknown keys rejected so that a typo never passes silently.
 
 use coseg::bands::BandWeighting;
-use coseg::cache::ShapePipelineOptions;
+use coseg::pipeline::ShapePipelineOptions;
 use coseg::graph::{CosegmentOptions, GraphOptions, SegmentCollectionOptions};
-use coseg::spectral::{Spectrum, ZoomOutOptions};
+use coseg::maps::{MapPreset, PointMapOptions, PresetChoice, ZoomOutOptions, map_preset};
+use coseg::spectral::Spectrum;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, PointMapOptions, PresetChoice,
-    RefineOptions, SegmentPairOptions, StableError, StableRegionsOptions, TSearch, Threshold,
-    map_preset,
+    Algorithm, AreaReference, Init, MapGuidedOptions, RefineOptions, SegmentPairOptions,
+    StableError, StableRegionsOptions, TSearch, Threshold,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
