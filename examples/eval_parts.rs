@@ -12,12 +12,12 @@
 //! scaled to unit area; a face's id is the majority id of its corners). Families: purity and
 //! coverage of the grouped parts (`coseg::evaluate`).
 
-use coseg::cache::ShapePipelineOptions;
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
 use coseg::graph::{
     AdaptiveOptions, Cosegmentation, LoadedCollection, SegmentCollectionOptions, load_collection,
     segment_collection,
 };
+use coseg::pipeline::ShapePipelineOptions;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

@@ -10,7 +10,6 @@ mod cotan_laplacian;
 mod heat_smoother;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
-mod nearest_rows;
 mod shift_invert;
 
 pub use cotan_laplacian::cotan_laplacian;
