@@ -39,6 +39,9 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
     let mut opts = args.pipeline.options()?;
+    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &opts) {
+        eprintln!("warning: {}: {w}", args.mesh.display());
+    }
     // User features are per shape: resolve the folder to this mesh's file.
     opts.families = opts.families.for_shape(&args.mesh)?;
     let data = match &args.cache {

@@ -2,14 +2,16 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use coseg::maps::MapGuidedOptions;
+use coseg::maps::ZoomOutOptions;
+use coseg::maps::{
+    MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
+};
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
 use coseg::pipeline::{PipelineError, ShapeData, load_shape};
-use coseg::spectral::ZoomOutOptions;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY,
-    PairShape, PointMapOptions, PresetChoice, RefineOptions, SegmentPairOptions,
-    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, map_preset,
-    segment_pair,
+    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
+    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -101,7 +103,7 @@ pub struct PairArgs {
     /// descriptors in the point map's last match; TOSCA within-class 95.7 % against 94.3 %,
     /// but worse on different bodies), `general`, or `auto`, which picks `near-isometric`
     /// when the two spectra agree (eigenvalue discrepancy below 0.03, see
-    /// `coseg::stable::map_preset`).
+    /// `coseg::maps::map_preset`).
     #[arg(long, value_enum, default_value = "auto")]
     map_preset: MapPresetArg,
     /// Same as `--map-preset near-isometric`.
@@ -200,7 +202,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         map_guided,
     };
     let t = Instant::now();
-    let regions = segment_pair(
+    let pair = segment_pair(
         PairShape {
             mesh: ma,
             spectrum: &da.spectrum,
@@ -215,8 +217,11 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         },
         &pair_options,
     )
-    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?
-    .regions;
+    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
+    for f in &pair.fallbacks {
+        eprintln!("warning: {} x {}: {f}", args.a.display(), args.b.display());
+    }
+    let regions = pair.regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
@@ -253,7 +258,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     .with_map_preset(pair_options.map_guided.as_ref().map(|_| PresetChoice {
         preset: chosen,
         discrepancy: choice.discrepancy,
-    }));
+    }))
+    .with_fallbacks(pair.fallbacks);
     let shapes = [
         ShapeRegions {
             name: &na,

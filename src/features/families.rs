@@ -205,9 +205,10 @@ pub fn parse_families(
         match item {
             "spectral" => spectral = true,
             "extrinsic" => {
-                let mut o = ExtrinsicOptions::default();
-                o.alignment = alignment;
-                f.extrinsic = Some(o);
+                f.extrinsic = Some(ExtrinsicOptions {
+                    alignment,
+                    ..Default::default()
+                });
             }
             "sdf" => f.sdf = Some(SdfOptions::default()),
             _ => match item.strip_prefix("user:") {
