@@ -129,7 +129,7 @@ fn stem(p: &Path) -> String {
 }
 
 pub fn run(args: PairArgs) -> Result<ExitCode> {
-    let pipe = args.pipeline.options();
+    let pipe = args.pipeline.options()?;
     let mut loaded = Vec::new();
     for path in [&args.a, &args.b] {
         let shape = match load_shape::<ShapeData>(path, &pipe, args.cache.as_deref()) {

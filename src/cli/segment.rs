@@ -82,7 +82,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         .cache
         .clone()
         .unwrap_or_else(|| args.out.join(".cache"));
-    let pipeline = args.pipeline.options();
+    let pipeline = args.pipeline.options()?;
     let t0 = Instant::now();
     let bar = std::io::stderr().is_terminal().then(|| {
         let b = ProgressBar::new(0);
@@ -139,6 +139,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             max_rounds: args.refine_rounds,
             smoothing_time: args.smoothing_time,
         }),
+        feature_weights: pipeline.feature_weights(loaded.nodes[0].bands.features),
         parts: args.parts.map(|p| {
             let mut o = AdaptiveOptions::default();
             if let PartsArg::Count(k) = p {

@@ -22,6 +22,9 @@ pub struct SegmentCollectionOptions {
     /// Boundary refinement after the co-segmentation; `None` keeps the raw region tuples.
     /// Default: [`SegmentCollectionOptions::DEFAULT_REFINE`].
     pub refine: Option<RefineOptions>,
+    /// Per-feature affinity weights on every edge (`None`: equal weights), e.g. the feature
+    /// families' weights ([`crate::pipeline::ShapePipelineOptions::feature_weights`]).
+    pub feature_weights: Option<Vec<f64>>,
     /// `Some`: parts of their own size by [`super::adaptive_cosegment`] (then cut at
     /// [`AdaptiveOptions::parts`] parts when set) instead of [`cosegment`]'s equal areas;
     /// `cosegment` is ignored. Default `None`.
@@ -47,6 +50,7 @@ impl Default for SegmentCollectionOptions {
             graph: GraphOptions::default(),
             cosegment: CosegmentOptions::default(),
             refine: Some(Self::DEFAULT_REFINE),
+            feature_weights: None,
             parts: None,
         }
     }
@@ -126,7 +130,10 @@ pub fn segment_collection(
     }
     let mut times = SegmentTimes::default();
     let t = Instant::now();
-    let graph = ShapeGraph::build(nodes, &options.graph)?;
+    let mut graph = ShapeGraph::build(nodes, &options.graph)?;
+    if options.feature_weights.is_some() {
+        graph.set_feature_weights(options.feature_weights.clone())?;
+    }
     times.graph = t.elapsed();
     let t = Instant::now();
     let (mut segmentation, adaptive) = match &options.parts {
