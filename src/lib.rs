@@ -16,7 +16,8 @@
 //! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
-//! | output | [`output`] | region files, coloured meshes, summaries |
+//! | output | [`output`] | region files, coloured meshes, summaries, the viewer page |
+//! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view) |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
 #![deny(missing_docs)]
@@ -30,5 +31,6 @@ pub mod generate;
 pub mod graph;
 pub mod mesh;
 pub mod output;
+pub mod render;
 pub mod spectral;
 pub mod stable;

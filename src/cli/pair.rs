@@ -4,7 +4,8 @@ use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
 use coseg::mesh::read_mesh_with_report;
-use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
+use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, write_visuals};
+use coseg::render::{RenderOptions, RenderShape};
 use coseg::spectral::ZoomOutOptions;
 use coseg::stable::{
     Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY,
@@ -48,12 +49,19 @@ pub struct PairArgs {
     a: PathBuf,
     /// Mesh B.
     b: PathBuf,
-    /// Output directory (created if missing).
-    #[arg(short, long)]
+    /// Output directory (created if missing); files listed in docs/OUTPUTS.md.
+    #[arg(short, long, visible_alias = "out")]
     output: PathBuf,
-    /// Per-shape cache directory (spectrum, features, bands; read if valid, written otherwise).
+    /// Per-shape cache directory (spectrum, features, bands; read if valid, written
+    /// otherwise). Default: `<OUTPUT>/.cache`.
     #[arg(long)]
     cache: Option<PathBuf>,
+    /// Compute the per-shape data without reading or writing a cache.
+    #[arg(long, conflicts_with = "cache")]
+    no_cache: bool,
+    /// Do not draw `preview.png`, `<name>.png` and `index.html`.
+    #[arg(long)]
+    no_pictures: bool,
     /// Algorithm 2 (fixed) or 3 (auto).
     #[arg(long, value_enum, default_value = "fixed")]
     algorithm: AlgorithmArg,
@@ -129,21 +137,30 @@ fn stem(p: &Path) -> String {
 
 pub fn run(args: PairArgs) -> Result<ExitCode> {
     let pipe = args.pipeline.options();
+    let cache = (!args.no_cache).then(|| {
+        args.cache
+            .clone()
+            .unwrap_or_else(|| args.output.join(".cache"))
+    });
     let mut loaded = Vec::new();
+    let bar = super::progress_bar(2);
     for path in [&args.a, &args.b] {
+        if let Some(b) = &bar {
+            b.set_message(format!("per-shape data: {}", path.display()));
+        }
         let (mesh, report) = read_mesh_with_report(path)?;
         for w in &report.warnings {
-            eprintln!("warning: {}: {w}", path.display());
+            super::warn(format_args!("{}: {w}", path.display()));
         }
-        let data = match &args.cache {
+        let data = match &cache {
             Some(dir) => {
                 let r = load_or_compute(&mesh, &pipe, dir)
                     .with_context(|| format!("{}", path.display()))?;
                 if let CacheOutcome::Recomputed { reason } = &r.outcome {
-                    eprintln!("warning: {reason}");
+                    super::warn(reason);
                 }
                 if let Some(e) = &r.write_error {
-                    eprintln!("warning: {e}");
+                    super::warn(e);
                 }
                 r.data
             }
@@ -152,6 +169,12 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             }
         };
         loaded.push((mesh, data));
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
     }
     let options = StableRegionsOptions {
         algorithm: match args.algorithm {
@@ -213,6 +236,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         map_guided,
     };
     let t = Instant::now();
+    let spin = super::spinner("stable regions, refinement and map step");
     let regions = segment_pair(
         PairShape {
             mesh: ma,
@@ -230,6 +254,9 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     )
     .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?
     .regions;
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
@@ -279,7 +306,27 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             regions: &lb,
         },
     ];
-    let written = write_regions(&args.output, &shapes, &summary)?;
+    let mut written = write_regions(&args.output, &shapes, &summary)?;
+    if !args.no_pictures {
+        let pictures: Vec<RenderShape> = shapes
+            .iter()
+            .map(|s| RenderShape {
+                name: s.name,
+                mesh: s.mesh,
+                labels: s.regions,
+                confidence: None,
+            })
+            .collect();
+        written.extend(write_visuals(
+            &args.output,
+            &pictures,
+            None,
+            &RenderOptions::default(),
+        )?);
+    }
+    if super::quiet() {
+        return Ok(ExitCode::SUCCESS);
+    }
     if pair_options.map_guided.is_some() {
         println!(
             "map step: {} preset (eigenvalue discrepancy {:.4}; near-isometric below {})",
@@ -304,5 +351,9 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         written.len(),
         args.output.display()
     );
+    if !args.no_pictures {
+        let out = args.output.display();
+        println!("pictures: {out}/preview.png; viewer: {out}/index.html");
+    }
     Ok(ExitCode::SUCCESS)
 }
