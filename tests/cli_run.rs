@@ -11,8 +11,18 @@ use std::time::{Duration, Instant};
 
 /// Small pipeline settings so that debug builds finish in seconds.
 const FAST: &[&str] = &[
-    "--eigenpairs", "20", "--hks", "6", "--wks", "6", "--curvature", "6", "--bands", "6",
-    "--regions", "3",
+    "--eigenpairs",
+    "20",
+    "--hks",
+    "6",
+    "--wks",
+    "6",
+    "--curvature",
+    "6",
+    "--bands",
+    "6",
+    "--regions",
+    "3",
 ];
 
 fn coseg(args: &[&str]) -> Output {
@@ -45,7 +55,12 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
         .unwrap()
         .map(|e| e.unwrap().path())
         .filter(|p| p.is_file())
-        .map(|p| (p.file_name().unwrap().to_string_lossy().into_owned(), std::fs::read(&p).unwrap()))
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
         .collect();
     out.sort();
     out
@@ -65,12 +80,21 @@ fn broken_file_is_reported_and_skipped_with_exit_3_and_strict_fails() {
     let run = coseg(&args);
     let (stdout, stderr) = (text(&run.stdout), text(&run.stderr));
     assert_eq!(run.status.code(), Some(3), "{stdout}{stderr}");
-    assert!(stderr.contains("broken.off") && stderr.contains("skipped"), "{stderr}");
+    assert!(
+        stderr.contains("broken.off") && stderr.contains("skipped"),
+        "{stderr}"
+    );
     assert!(!stderr.contains("notes.txt"), "{stderr}");
     assert!(stdout.contains("3 shapes co-segmented"), "{stdout}");
     let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
     assert!(summary.contains("broken.off"), "{summary}");
-    for name in ["s0.regions.txt", "s1.png", "s2.regions.ply", "preview.png", "index.html"] {
+    for name in [
+        "s0.regions.txt",
+        "s1.png",
+        "s2.regions.ply",
+        "preview.png",
+        "index.html",
+    ] {
         assert!(out.join(name).is_file(), "{name} missing");
     }
 
@@ -80,7 +104,10 @@ fn broken_file_is_reported_and_skipped_with_exit_3_and_strict_fails() {
     let run = coseg(&args);
     let stderr = text(&run.stderr);
     assert_eq!(run.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("broken.off") && stderr.contains("--strict"), "{stderr}");
+    assert!(
+        stderr.contains("broken.off") && stderr.contains("--strict"),
+        "{stderr}"
+    );
     assert!(!strict_out.join("summary.json").exists());
 }
 
@@ -91,7 +118,14 @@ fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
     std::fs::create_dir(&input).unwrap();
     shapes(&input, 2, 2);
     let out = dir.path().join("out");
-    let mut args = vec!["segment", s(&input), "-o", s(&out), "--quiet", "--no-pictures"];
+    let mut args = vec![
+        "segment",
+        s(&input),
+        "-o",
+        s(&out),
+        "--quiet",
+        "--no-pictures",
+    ];
     args.extend(FAST);
     let run = coseg(&args);
     assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
@@ -102,12 +136,32 @@ fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
 
     let pair_out = dir.path().join("pair");
     let run = coseg(&[
-        "-q", "pair", s(&input.join("s0.obj")), s(&input.join("s1.off")), "-o", s(&pair_out),
-        "--eigenpairs", "20", "--hks", "6", "--wks", "6", "--curvature", "6", "--bands", "6",
-        "--pairs", "3",
+        "-q",
+        "pair",
+        s(&input.join("s0.obj")),
+        s(&input.join("s1.off")),
+        "-o",
+        s(&pair_out),
+        "--eigenpairs",
+        "20",
+        "--hks",
+        "6",
+        "--wks",
+        "6",
+        "--curvature",
+        "6",
+        "--bands",
+        "6",
+        "--pairs",
+        "3",
     ]);
     assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
-    assert!(run.stdout.is_empty() && run.stderr.is_empty(), "{}{}", text(&run.stdout), text(&run.stderr));
+    assert!(
+        run.stdout.is_empty() && run.stderr.is_empty(),
+        "{}{}",
+        text(&run.stdout),
+        text(&run.stderr)
+    );
     // pair caches by default, like segment, and draws its pictures.
     assert!(std::fs::read_dir(pair_out.join(".cache")).unwrap().count() >= 2);
     assert!(pair_out.join("preview.png").is_file() && pair_out.join("s0.png").is_file());
@@ -117,17 +171,32 @@ fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
 fn render_writes_a_png_of_the_expected_size_that_is_not_one_colour() {
     let dir = tempfile::tempdir().unwrap();
     shapes(dir.path(), 3, 2);
-    let labels: String = (0..blob(2).vertex_count()).map(|i| format!("{}\n", i % 4)).collect();
+    let labels: String = (0..blob(2).vertex_count())
+        .map(|i| format!("{}\n", i % 4))
+        .collect();
     let lab = dir.path().join("s0.labels.txt");
     std::fs::write(&lab, labels).unwrap();
     let png_path = dir.path().join("sheet.png");
     let run = coseg(&[
-        "render", s(&dir.path().join("s0.obj")), s(&dir.path().join("s1.off")),
-        s(&dir.path().join("s2.ply")), "-o", s(&png_path), "--cell-size", "100", "--columns", "3",
-        "--labels", s(&lab), s(&lab), s(&lab),
+        "render",
+        s(&dir.path().join("s0.obj")),
+        s(&dir.path().join("s1.off")),
+        s(&dir.path().join("s2.ply")),
+        "-o",
+        s(&png_path),
+        "--cell-size",
+        "100",
+        "--columns",
+        "3",
+        "--labels",
+        s(&lab),
+        s(&lab),
+        s(&lab),
     ]);
     assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
-    let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&png_path).unwrap()));
+    let dec = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(&png_path).unwrap(),
+    ));
     let mut reader = dec.read_info().unwrap();
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
     let info = reader.next_frame(&mut buf).unwrap();
@@ -139,9 +208,20 @@ fn render_writes_a_png_of_the_expected_size_that_is_not_one_colour() {
     assert!(colours.len() > 20, "{} colours", colours.len());
     // A label file of the wrong length is named in the error.
     std::fs::write(&lab, "0\n1\n").unwrap();
-    let run = coseg(&["render", s(&dir.path().join("s0.obj")), "--labels", s(&lab), "-o", s(&png_path)]);
+    let run = coseg(&[
+        "render",
+        s(&dir.path().join("s0.obj")),
+        "--labels",
+        s(&lab),
+        "-o",
+        s(&png_path),
+    ]);
     assert_eq!(run.status.code(), Some(1));
-    assert!(text(&run.stderr).contains("s0.labels.txt"), "{}", text(&run.stderr));
+    assert!(
+        text(&run.stderr).contains("s0.labels.txt"),
+        "{}",
+        text(&run.stderr)
+    );
 }
 
 fn cache_entries(dir: &Path) -> Vec<PathBuf> {
@@ -184,8 +264,14 @@ fn run_killed_during_per_shape_stage_resumes_to_identical_outputs_redoing_only_t
         .unwrap();
     let t0 = Instant::now();
     while cache_entries(&cache).is_empty() {
-        assert!(t0.elapsed() < Duration::from_secs(300), "no cache entry after 300 s");
-        assert!(child.try_wait().unwrap().is_none(), "the run ended before it could be killed");
+        assert!(
+            t0.elapsed() < Duration::from_secs(300),
+            "no cache entry after 300 s"
+        );
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before it could be killed"
+        );
         std::thread::sleep(Duration::from_millis(5));
     }
     child.kill().unwrap();
@@ -196,16 +282,30 @@ fn run_killed_during_per_shape_stage_resumes_to_identical_outputs_redoing_only_t
         "killed with {} of {n} shapes cached: not during the per-shape stage",
         done.len()
     );
-    assert!(!out.join("summary.json").exists(), "killed before any output");
-    let stamps: Vec<_> = done.iter().map(|p| std::fs::metadata(p).unwrap().modified().unwrap()).collect();
+    assert!(
+        !out.join("summary.json").exists(),
+        "killed before any output"
+    );
+    let stamps: Vec<_> = done
+        .iter()
+        .map(|p| std::fs::metadata(p).unwrap().modified().unwrap())
+        .collect();
 
     let run = coseg(&args);
     let stdout = text(&run.stdout);
     assert_eq!(run.status.code(), Some(0), "{stdout}{}", text(&run.stderr));
     // Only the unfinished shapes were computed again.
-    assert!(stdout.contains(&format!("({} cached)", done.len())), "{stdout}");
+    assert!(
+        stdout.contains(&format!("({} cached)", done.len())),
+        "{stdout}"
+    );
     for (p, t) in done.iter().zip(&stamps) {
-        assert_eq!(std::fs::metadata(p).unwrap().modified().unwrap(), *t, "{} rewritten", p.display());
+        assert_eq!(
+            std::fs::metadata(p).unwrap().modified().unwrap(),
+            *t,
+            "{} rewritten",
+            p.display()
+        );
     }
     assert_eq!(cache_entries(&cache).len(), n);
     let (a, b) = (files(&reference), files(&out));
@@ -214,6 +314,9 @@ fn run_killed_during_per_shape_stage_resumes_to_identical_outputs_redoing_only_t
         b.iter().map(|f| &f.0).collect::<Vec<_>>()
     );
     for ((name, x), (_, y)) in a.iter().zip(&b) {
-        assert!(x == y, "{name} differs between the resumed and the uninterrupted run");
+        assert!(
+            x == y,
+            "{name} differs between the resumed and the uninterrupted run"
+        );
     }
 }

@@ -9,13 +9,15 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn chromium() -> Option<PathBuf> {
-    ["chromium", "chromium-browser", "google-chrome"].iter().find_map(|name| {
-        std::env::var_os("PATH")?
-            .to_str()?
-            .split(':')
-            .map(|d| Path::new(d).join(name))
-            .find(|p| p.is_file())
-    })
+    ["chromium", "chromium-browser", "google-chrome"]
+        .iter()
+        .find_map(|name| {
+            std::env::var_os("PATH")?
+                .to_str()?
+                .split(':')
+                .map(|d| Path::new(d).join(name))
+                .find(|p| p.is_file())
+        })
 }
 
 /// Chromium headless on `page` with a fresh profile; `extra` selects the output.
@@ -58,17 +60,44 @@ fn viewer_page_renders_in_headless_chromium_without_console_errors() {
     }
     let out = dir.path().join("out");
     let run = Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args(["segment", input.to_str().unwrap(), "-o", out.to_str().unwrap()])
-        .args(["--eigenpairs", "20", "--hks", "6", "--wks", "6", "--curvature", "6"])
+        .args([
+            "segment",
+            input.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ])
+        .args([
+            "--eigenpairs",
+            "20",
+            "--hks",
+            "6",
+            "--wks",
+            "6",
+            "--curvature",
+            "6",
+        ])
         .args(["--bands", "6", "--regions", "3"])
         .output()
         .unwrap();
-    assert_eq!(run.status.code(), Some(0), "{}", String::from_utf8_lossy(&run.stderr));
+    assert_eq!(
+        run.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let page = out.join("index.html");
     let html = std::fs::read_to_string(&page).unwrap();
-    assert!(!html.contains("http:") && !html.contains("https:"), "the page must not fetch anything");
+    assert!(
+        !html.contains("http:") && !html.contains("https:"),
+        "the page must not fetch anything"
+    );
 
-    let dom = browse(&browser, &dir.path().join("profile1"), &page, &["--dump-dom".into()]);
+    let dom = browse(
+        &browser,
+        &dir.path().join("profile1"),
+        &page,
+        &["--dump-dom".into()],
+    );
     let (dom_text, log) = (
         String::from_utf8_lossy(&dom.stdout).into_owned(),
         String::from_utf8_lossy(&dom.stderr).into_owned(),
@@ -76,7 +105,11 @@ fn viewer_page_renders_in_headless_chromium_without_console_errors() {
     assert!(
         dom_text.contains(r#"<div id="status" class="ok">ok: 2 shapes</div>"#),
         "status not ok:\n{}\n{log}",
-        dom_text.lines().filter(|l| l.contains("status")).collect::<Vec<_>>().join("\n")
+        dom_text
+            .lines()
+            .filter(|l| l.contains("status"))
+            .collect::<Vec<_>>()
+            .join("\n")
     );
     assert!(dom_text.contains("blob0") && dom_text.contains("blob1"));
     // Console messages other than the driver's performance notes are errors of the page.
@@ -84,16 +117,27 @@ fn viewer_page_renders_in_headless_chromium_without_console_errors() {
         .lines()
         .filter(|l| l.contains(":CONSOLE") && !l.contains("GL Driver Message"))
         .collect();
-    assert!(console.is_empty(), "console output:\n{}", console.join("\n"));
+    assert!(
+        console.is_empty(),
+        "console output:\n{}",
+        console.join("\n")
+    );
 
     let shot = dir.path().join("shot.png");
     let run = browse(
         &browser,
         &dir.path().join("profile2"),
         &page,
-        &["--window-size=800,600".into(), format!("--screenshot={}", shot.display())],
+        &[
+            "--window-size=800,600".into(),
+            format!("--screenshot={}", shot.display()),
+        ],
     );
-    assert!(shot.is_file(), "no screenshot: {}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        shot.is_file(),
+        "no screenshot: {}",
+        String::from_utf8_lossy(&run.stderr)
+    );
     let dec = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&shot).unwrap()));
     let mut reader = dec.read_info().unwrap();
     let mut buf = vec![0; reader.output_buffer_size().unwrap()];
@@ -111,5 +155,8 @@ fn viewer_page_renders_in_headless_chromium_without_console_errors() {
             }
         }
     }
-    assert!(coloured > 5000, "only {coloured} coloured pixels: the 3D view looks blank");
+    assert!(
+        coloured > 5000,
+        "only {coloured} coloured pixels: the 3D view looks blank"
+    );
 }

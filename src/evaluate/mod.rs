@@ -28,14 +28,18 @@
 
 mod ground_truth;
 mod group_parts;
+mod matched_scores;
 mod part_coverage;
 mod part_purity;
+mod rand_index;
 mod read_labels;
 
 pub use ground_truth::GroundTruth;
 pub use group_parts::{PartGroups, group_parts};
+pub use matched_scores::{MatchedScores, matched_scores};
 pub use part_coverage::part_coverage;
 pub use part_purity::part_purity;
+pub use rand_index::rand_index;
 pub use read_labels::read_labels;
 
 use crate::mesh::TriMesh;
