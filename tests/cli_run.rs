@@ -320,3 +320,24 @@ fn run_killed_during_per_shape_stage_resumes_to_identical_outputs_redoing_only_t
         );
     }
 }
+
+#[test]
+fn help_shows_an_example_for_every_subcommand_and_the_shared_flags() {
+    let top = text(&coseg(&["--help"]).stdout);
+    assert!(
+        top.contains("Examples:") && top.contains("--quiet") && top.contains("--strict"),
+        "{top}"
+    );
+    for cmd in [
+        "info", "spectrum", "convert", "features", "generate", "pair", "segment", "render", "eval",
+    ] {
+        let out = coseg(&[cmd, "--help"]);
+        let help = text(&out.stdout);
+        assert_eq!(out.status.code(), Some(0), "{cmd}");
+        assert!(
+            help.contains(&format!("coseg {cmd} ")),
+            "{cmd} --help has no example:\n{help}"
+        );
+        assert!(help.contains("--threads"), "{cmd}");
+    }
+}

@@ -28,7 +28,7 @@ Examples:
   coseg generate quadrupeds -o shapes/           # a synthetic family with ground truth
   coseg segment shapes/ -o out/                  # co-segment a folder; out/preview.png, out/index.html
   coseg pair a.off b.off -o out/ --ground-truth identity
-  coseg render out/*.regions.ply -o sheet.png    # pictures of meshes (labels from PLY or --labels)
+  coseg render out/*.regions.ply -o sheet.png    # pictures; labels from X.regions.txt or --labels
   coseg eval out/ --truth shapes/                # accuracy, IoU, Rand index against ground truth
   coseg info a.off b.obj                         # counts and warnings
 Exit codes: 0 success, 1 failure, 3 some inputs were skipped (use --strict to make that fatal).
@@ -71,7 +71,7 @@ enum Command {
     #[command(after_help = "Example:\n  coseg convert cat0.off cat0.ply")]
     Convert(convert::ConvertArgs),
     /// Compute a mesh's descriptors and band table and export them (.npy or .csv).
-    #[command(after_help = "Example:\n  coseg features cat0.off -o cat0.features.npy")]
+    #[command(after_help = "Example:\n  coseg features cat0.off -o cat0_features/")]
     Features(features::FeaturesArgs),
     /// Generate a synthetic shape family with ground-truth part labels.
     #[command(after_help = "Example:\n  coseg generate quadrupeds -o shapes/ --count 6")]
