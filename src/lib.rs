@@ -13,11 +13,14 @@
 //! | spectrum | [`spectral`] | cotangent Laplacian, lumped mass, Laplace–Beltrami eigenpairs |
 //! | features | [`features`] | HKS, WKS and multiscale mean curvature per vertex |
 //! | bands | [`bands`] | per-feature rank bands stored as a compact `u8` table |
+//! | per-shape pipeline | [`pipeline`] | mesh → spectrum → features → bands once per shape, through [`cache`] (storage only); [`pipeline::load_shape`] is the one loader |
+//! | correspondence maps | [`maps`] | functional maps, ZoomOut, one-to-one matches, map presets |
 //! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
 //! | output | [`output`] | region files, coloured meshes, summaries, the viewer page |
 //! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view) |
+//! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
 #![deny(missing_docs)]
@@ -29,8 +32,11 @@ pub mod evaluate;
 pub mod features;
 pub mod generate;
 pub mod graph;
+pub mod labels;
+pub mod maps;
 pub mod mesh;
 pub mod output;
+pub mod pipeline;
 pub mod render;
 pub mod spectral;
 pub mod stable;

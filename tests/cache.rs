@@ -4,11 +4,12 @@
 mod common;
 
 use common::features::{blob, permutation, permute_mesh};
-use coseg::cache::{
-    CacheOutcome, ShapePipelineOptions, cache_path, compute_shape_data, encode_entry,
-    load_or_compute, mesh_hash, shape_key,
-};
+use coseg::cache::{CacheOutcome, cache_path, mesh_hash};
 use coseg::mesh::TriMesh;
+use coseg::pipeline::{
+    ShapePipelineOptions, compute_shape_data, encode_shape_entry as encode_entry, load_or_compute,
+    shape_key,
+};
 
 fn opts() -> ShapePipelineOptions {
     common::features::small_pipeline(20, 6)
@@ -178,7 +179,8 @@ fn a_file_in_place_of_the_directory_is_an_error_not_a_panic() {
 /// holds exactly the full entry's band table and vertex areas.
 #[test]
 fn bands_entry_miss_then_hit_matches_the_full_entry() {
-    use coseg::cache::{ShapeBands, bands_path, load_or_compute_bands};
+    use coseg::cache::bands_path;
+    use coseg::pipeline::{ShapeBands, load_or_compute_bands};
     let dir = tempfile::tempdir().unwrap();
     let (m, o) = (mesh(), opts());
     let first = load_or_compute_bands(&m, &o, dir.path()).unwrap();
@@ -200,7 +202,8 @@ fn bands_entry_miss_then_hit_matches_the_full_entry() {
 /// rebuilt silently.
 #[test]
 fn bad_bands_entries_are_rebuilt_from_the_full_entry() {
-    use coseg::cache::{bands_path, load_or_compute_bands};
+    use coseg::cache::bands_path;
+    use coseg::pipeline::load_or_compute_bands;
     let dir = tempfile::tempdir().unwrap();
     let (m, o) = (mesh(), opts());
     let good = load_or_compute_bands(&m, &o, dir.path()).unwrap().data;

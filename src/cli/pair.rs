@@ -2,16 +2,16 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
-use coseg::mesh::read_mesh_with_report;
+use coseg::maps::ZoomOutOptions;
+use coseg::maps::{
+    MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
+};
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, write_visuals};
+use coseg::pipeline::{PipelineError, ShapeData, load_shape};
 use coseg::render::{RenderOptions, RenderShape};
-use coseg::spectral::ZoomOutOptions;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY,
-    PairShape, PointMapOptions, PresetChoice, RefineOptions, SegmentPairOptions,
-    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, map_preset,
-    segment_pair,
+    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions,
+    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -110,7 +110,7 @@ pub struct PairArgs {
     /// descriptors in the point map's last match; TOSCA within-class 95.7 % against 94.3 %,
     /// but worse on different bodies), `general`, or `auto`, which picks `near-isometric`
     /// when the two spectra agree (eigenvalue discrepancy below 0.03, see
-    /// `coseg::stable::map_preset`).
+    /// `coseg::maps::map_preset`).
     #[arg(long, value_enum, default_value = "auto")]
     map_preset: MapPresetArg,
     /// Same as `--map-preset near-isometric`.
@@ -148,27 +148,15 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         if let Some(b) = &bar {
             b.set_message(format!("per-shape data: {}", path.display()));
         }
-        let (mesh, report) = read_mesh_with_report(path)?;
-        for w in &report.warnings {
-            super::warn(format_args!("{}: {w}", path.display()));
-        }
-        let data = match &cache {
-            Some(dir) => {
-                let r = load_or_compute(&mesh, &pipe, dir)
-                    .with_context(|| format!("{}", path.display()))?;
-                if let CacheOutcome::Recomputed { reason } = &r.outcome {
-                    super::warn(reason);
-                }
-                if let Some(e) = &r.write_error {
-                    super::warn(e);
-                }
-                r.data
-            }
-            None => {
-                compute_shape_data(&mesh, &pipe).with_context(|| format!("{}", path.display()))?
-            }
+        let shape = match load_shape::<ShapeData>(path, &pipe, cache.as_deref()) {
+            Ok(s) => s,
+            Err(PipelineError::Mesh(e)) => return Err(e.into()),
+            Err(e) => return Err(anyhow::Error::new(e).context(format!("{}", path.display()))),
         };
-        loaded.push((mesh, data));
+        for w in &shape.warnings {
+            super::warn(w);
+        }
+        loaded.push((shape.mesh, shape.data));
         if let Some(b) = &bar {
             b.inc(1);
         }
@@ -237,7 +225,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     };
     let t = Instant::now();
     let spin = super::spinner("stable regions, refinement and map step");
-    let regions = segment_pair(
+    let pair = segment_pair(
         PairShape {
             mesh: ma,
             spectrum: &da.spectrum,
@@ -252,11 +240,18 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         },
         &pair_options,
     )
-    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?
-    .regions;
+    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
     if let Some(b) = spin {
         b.finish_and_clear();
     }
+    for f in &pair.fallbacks {
+        super::warn(format_args!(
+            "{} x {}: {f}",
+            args.a.display(),
+            args.b.display()
+        ));
+    }
+    let regions = pair.regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
@@ -293,7 +288,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     .with_map_preset(pair_options.map_guided.as_ref().map(|_| PresetChoice {
         preset: chosen,
         discrepancy: choice.discrepancy,
-    }));
+    }))
+    .with_fallbacks(pair.fallbacks);
     let shapes = [
         ShapeRegions {
             name: &na,

@@ -25,7 +25,9 @@ mod stable_cycle;
 
 pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
 pub use cycle_consistency::{CycleConsistency, cycle_consistency};
-pub use load_collection::{LoadedCollection, SkippedFile, load_collection, mesh_files};
+pub use load_collection::{
+    LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
+};
 pub use refine_cosegmentation::refine_cosegmentation;
 pub use segment_collection::{
     SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection,

@@ -1,7 +1,8 @@
 //! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
 //! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
 
-use super::{AuctionOptions, CandidateLists, SpectralError, Spectrum, auction_assignment};
+use super::{AuctionOptions, CandidateLists, auction_assignment};
+use crate::spectral::{SpectralError, Spectrum};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 use nalgebra::DMatrix;
@@ -9,7 +10,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Options of [`zoomout`] (and of the ZoomOut stage of
-/// [`region_point_map`](crate::stable::region_point_map)).
+/// [`region_point_map`](crate::maps::region_point_map)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ZoomOutOptions {
     /// Size `k₀` of the first functional map (default 10).
@@ -104,7 +105,8 @@ pub struct ShapeGeometry<'a> {
 ///
 /// ```
 /// use coseg::mesh::TriMesh;
-/// use coseg::spectral::{laplace_beltrami_spectrum, zoomout, ShapeGeometry, SpectrumOptions, ZoomOutOptions};
+/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions};
+/// use coseg::maps::{ShapeGeometry, ZoomOutOptions, zoomout};
 /// // A 9 × 3 grid of points.
 /// let (nx, ny) = (9u32, 3u32);
 /// let pos: Vec<[f64; 3]> = (0..nx * ny).map(|i| [(i % nx) as f64, (i / nx) as f64, 0.0]).collect();
@@ -320,10 +322,47 @@ fn spectral_fit(
     let b = DMatrix::from_fn(phi_b.nrows(), k, |i, j| phi_b[(i, j)]);
     let a = DMatrix::from_fn(t.len(), k, |i, j| phi_a[(t[i] as usize, j)]);
     let btb = b.transpose() * &b;
-    let bta = b.transpose() * a;
-    btb.cholesky()
-        .map(|ch| ch.solve(&bta))
-        .ok_or_else(|| SpectralError::Solver("ZoomOut: sampled eigenbasis is singular".into()))
+    let bta = b.transpose() * &a;
+    // A shape with several components has basis functions that vanish on (nearly) every
+    // sample, so `BᵀB` can be singular or close to it: then the minimum-norm least-squares
+    // map (SVD, relative cutoff) leaves their coefficients at zero instead of failing.
+    let diagonal = (0..k).map(|i| btb[(i, i)]);
+    let largest = diagonal.clone().fold(0.0, f64::max);
+    let smallest = diagonal.fold(f64::INFINITY, f64::min);
+    if smallest > 1e-10 * largest
+        && let Some(ch) = btb.clone().cholesky()
+    {
+        let ch_diag = ch.l_dirty().diagonal();
+        let (lo, hi) = ch_diag
+            .iter()
+            .fold((f64::INFINITY, 0.0f64), |(lo, hi), &x| {
+                (lo.min(x.abs()), hi.max(x.abs()))
+            });
+        if lo > 1e-6 * hi {
+            let c = ch.solve(&bta);
+            if c.iter().all(|x| x.is_finite()) {
+                return Ok(c);
+            }
+        }
+    }
+    minimum_norm_fit(b, a)
+}
+
+/// `argmin ‖B C − A‖` of least norm, singular values of `B` below `1e-9 ×` the largest taken
+/// as zero.
+fn minimum_norm_fit(b: DMatrix<f64>, a: DMatrix<f64>) -> Result<DMatrix<f64>, SpectralError> {
+    let svd = b.svd(true, true);
+    let cutoff = 1e-9 * svd.singular_values.max();
+    let c = svd
+        .solve(&a, cutoff)
+        .map_err(|e| SpectralError::Solver(format!("ZoomOut: least-squares map: {e}")))?;
+    if c.iter().all(|x| x.is_finite()) {
+        Ok(c)
+    } else {
+        Err(SpectralError::Solver(
+            "ZoomOut: the sampled eigenbasis gives a non-finite map".into(),
+        ))
+    }
 }
 
 /// Rows of `phi` at `count` farthest-point samples of `positions` (all rows when `count ≥ d`),
@@ -353,7 +392,38 @@ fn sample_rows(phi: MatRef<'_, f64>, positions: &[[f64; 3]], count: usize) -> Ma
         }
         out
     };
+    let chosen = cover_basis(phi, chosen);
     Mat::from_fn(chosen.len(), phi.ncols(), |i, j| phi[(chosen[i], j)])
+}
+
+/// `chosen` plus, for every column of `phi` that (almost) vanishes on the chosen rows, the
+/// row where it is largest. Farthest-point samples can miss a small component entirely, and
+/// a basis function living there (its constant, at least) is then zero on every sample; one
+/// sample on it keeps the fitted map from ignoring it. A no-op on a connected surface, where
+/// no low-frequency eigenfunction vanishes on well-spread samples.
+fn cover_basis(phi: MatRef<'_, f64>, mut chosen: Vec<usize>) -> Vec<usize> {
+    let d = phi.nrows();
+    if chosen.len() >= d {
+        return chosen;
+    }
+    let mut taken = vec![false; d];
+    chosen.iter().for_each(|&v| taken[v] = true);
+    for j in 0..phi.ncols() {
+        let col = phi.col(j);
+        let total: f64 = col.iter().map(|x| x * x).sum();
+        let sampled: f64 = chosen.iter().map(|&v| col[v] * col[v]).sum();
+        // Mass-orthonormal columns spread over the samples carry about their share of the
+        // squared norm; a millionth of it means the samples do not see the function.
+        if sampled > 1e-6 * total * chosen.len() as f64 / d as f64 {
+            continue;
+        }
+        let best = (0..d).fold(0, |b, v| if col[v].abs() > col[b].abs() { v } else { b });
+        if !taken[best] {
+            taken[best] = true;
+            chosen.push(best);
+        }
+    }
+    chosen
 }
 
 /// Rows of `query` per block: fixed, so the result does not depend on the thread count.
