@@ -18,7 +18,8 @@
 //! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
-//! | output | [`output`] | region files, coloured meshes, summaries |
+//! | output | [`output`] | region files, coloured meshes, summaries, the viewer page |
+//! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view) |
 //! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
@@ -37,6 +38,7 @@ pub mod maps;
 pub mod mesh;
 pub mod output;
 pub mod pipeline;
+pub mod render;
 pub mod shape_task;
 pub mod spectral;
 pub mod stable;

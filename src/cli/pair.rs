@@ -7,8 +7,9 @@ use coseg::maps::ZoomOutOptions;
 use coseg::maps::{
     MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
 };
-use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
+use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, write_visuals};
 use coseg::pipeline::{PipelineError, ShapeData, load_shape};
+use coseg::render::{RenderOptions, RenderShape};
 use coseg::stable::{
     Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
     StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
@@ -49,12 +50,19 @@ pub struct PairArgs {
     a: PathBuf,
     /// Mesh B.
     b: PathBuf,
-    /// Output directory (created if missing).
-    #[arg(short, long)]
+    /// Output directory (created if missing); files listed in docs/OUTPUTS.md.
+    #[arg(short, long, visible_alias = "out")]
     output: PathBuf,
-    /// Per-shape cache directory (spectrum, features, bands; read if valid, written otherwise).
+    /// Per-shape cache directory (spectrum, features, bands; read if valid, written
+    /// otherwise). Default: `<OUTPUT>/.cache`.
     #[arg(long)]
     cache: Option<PathBuf>,
+    /// Compute the per-shape data without reading or writing a cache.
+    #[arg(long, conflicts_with = "cache")]
+    no_cache: bool,
+    /// Do not draw `preview.png`, `<name>.png` and `index.html`.
+    #[arg(long)]
+    no_pictures: bool,
     /// Algorithm 2 (fixed) or 3 (auto).
     #[arg(long, value_enum, default_value = "fixed")]
     algorithm: AlgorithmArg,
@@ -130,17 +138,32 @@ fn stem(p: &Path) -> String {
 
 pub fn run(args: PairArgs) -> Result<ExitCode> {
     let pipe = args.pipeline.options()?;
+    let cache = (!args.no_cache).then(|| {
+        args.cache
+            .clone()
+            .unwrap_or_else(|| args.output.join(".cache"))
+    });
     let mut loaded = Vec::new();
+    let bar = super::progress_bar(2);
     for path in [&args.a, &args.b] {
-        let shape = match load_shape::<ShapeData>(path, &pipe, args.cache.as_deref()) {
+        if let Some(b) = &bar {
+            b.set_message(format!("per-shape data: {}", path.display()));
+        }
+        let shape = match load_shape::<ShapeData>(path, &pipe, cache.as_deref()) {
             Ok(s) => s,
             Err(PipelineError::Mesh(e)) => return Err(e.into()),
             Err(e) => return Err(anyhow::Error::new(e).context(format!("{}", path.display()))),
         };
         for w in &shape.warnings {
-            eprintln!("warning: {w}");
+            super::warn(w);
         }
         loaded.push((shape.mesh, shape.data));
+        if let Some(b) = &bar {
+            b.inc(1);
+        }
+    }
+    if let Some(b) = bar {
+        b.finish_and_clear();
     }
     let options = StableRegionsOptions {
         algorithm: match args.algorithm {
@@ -202,6 +225,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         map_guided,
     };
     let t = Instant::now();
+    let spin = super::spinner("stable regions, refinement and map step");
     let pair = segment_pair(
         PairShape {
             mesh: ma,
@@ -218,8 +242,15 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         &pair_options,
     )
     .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
     for f in &pair.fallbacks {
-        eprintln!("warning: {} x {}: {f}", args.a.display(), args.b.display());
+        super::warn(format_args!(
+            "{} x {}: {f}",
+            args.a.display(),
+            args.b.display()
+        ));
     }
     let regions = pair.regions;
     let seconds = t.elapsed().as_secs_f64();
@@ -272,7 +303,27 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             regions: &lb,
         },
     ];
-    let written = write_regions(&args.output, &shapes, &summary)?;
+    let mut written = write_regions(&args.output, &shapes, &summary)?;
+    if !args.no_pictures {
+        let pictures: Vec<RenderShape> = shapes
+            .iter()
+            .map(|s| RenderShape {
+                name: s.name,
+                mesh: s.mesh,
+                labels: s.regions,
+                confidence: None,
+            })
+            .collect();
+        written.extend(write_visuals(
+            &args.output,
+            &pictures,
+            None,
+            &RenderOptions::default(),
+        )?);
+    }
+    if super::quiet() {
+        return Ok(ExitCode::SUCCESS);
+    }
     if pair_options.map_guided.is_some() {
         println!(
             "map step: {} preset (eigenvalue discrepancy {:.4}; near-isometric below {})",
@@ -297,5 +348,9 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         written.len(),
         args.output.display()
     );
+    if !args.no_pictures {
+        let out = args.output.display();
+        println!("pictures: {out}/preview.png; viewer: {out}/index.html");
+    }
     Ok(ExitCode::SUCCESS)
 }

@@ -7,10 +7,9 @@ use coseg::graph::{
     AdaptiveOptions, CosegmentOptions, GraphOptions, PartsReport, SegmentCollectionOptions,
     load_collection, segment_collection,
 };
-use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions};
+use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
+use coseg::render::{RenderOptions, RenderShape};
 use coseg::stable::RefineOptions;
-use indicatif::{ProgressBar, ProgressStyle};
-use std::io::IsTerminal;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -19,10 +18,13 @@ use std::time::Instant;
 pub struct SegmentArgs {
     /// Folder of meshes (.obj, .off, .ply); every mesh file directly in it is used.
     folder: PathBuf,
-    /// Output folder: `<name>.regions.txt`, `<name>.regions.ply` (coloured) per shape,
-    /// `summary.json`.
-    #[arg(short, long)]
+    /// Output folder: `<name>.regions.txt`, `<name>.regions.ply` (coloured) and `<name>.png`
+    /// per shape, `summary.json`, `preview.png`, `index.html` (docs/OUTPUTS.md).
+    #[arg(short, long, visible_alias = "output")]
     out: PathBuf,
+    /// Do not draw `preview.png`, `<name>.png` and `index.html`.
+    #[arg(long)]
+    no_pictures: bool,
     /// Per-shape cache folder (default: `<OUT>/.cache`).
     #[arg(long)]
     cache: Option<PathBuf>,
@@ -84,14 +86,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         .unwrap_or_else(|| args.out.join(".cache"));
     let pipeline = args.pipeline.options()?;
     let t0 = Instant::now();
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let b = ProgressBar::new(0);
-        b.set_style(
-            ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b
-    });
+    let bar = super::progress_bar(0);
     let loaded = load_collection(&args.folder, &pipeline, &cache, |i, total, path| {
         if let Some(b) = &bar {
             b.set_length(total as u64);
@@ -107,8 +102,9 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         eprintln!("error: {} (skipped)", s.error);
     }
     for w in &loaded.warnings {
-        eprintln!("warning: {w}");
+        super::warn(w);
     }
+    super::check_strict(loaded.skipped.len())?;
     let total_files = loaded.nodes.len() + loaded.skipped.len();
     if total_files == 0 {
         bail!(
@@ -153,7 +149,11 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             o
         }),
     };
+    let spin = super::spinner("co-segmentation and refinement");
     let result = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?;
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
     let seg = &result.segmentation;
     let t_write = Instant::now();
     let files: Vec<String> = loaded
@@ -193,13 +193,48 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             regions,
         })
         .collect();
-    let written = write_regions(&args.out, &shapes, &summary)?;
+    let mut written = write_regions(&args.out, &shapes, &summary)?;
+    if !args.no_pictures {
+        let spin = super::spinner("pictures");
+        let pictures: Vec<RenderShape> = shapes
+            .iter()
+            .map(|s| RenderShape {
+                name: s.name,
+                mesh: s.mesh,
+                labels: s.regions,
+                confidence: None,
+            })
+            .collect();
+        let names: Vec<String> = summary
+            .regions
+            .iter()
+            .map(|r| {
+                if r.leftover {
+                    "leftovers".to_string()
+                } else {
+                    format!("({:.0}%)", 100.0 * r.confidence)
+                }
+            })
+            .collect();
+        written.extend(write_visuals(
+            &args.out,
+            &pictures,
+            Some(&names),
+            &RenderOptions::default(),
+        )?);
+        if let Some(b) = spin {
+            b.finish_and_clear();
+        }
+    }
     let write_time = t_write.elapsed();
     let hits = loaded
         .outcomes
         .iter()
         .filter(|o| **o == CacheOutcome::Hit)
         .count();
+    if super::quiet() {
+        return Ok(super::exit_code(loaded.skipped.len(), total_files));
+    }
     println!(
         "{} shapes co-segmented into {} regions; {} files in {}",
         loaded.nodes.len(),
@@ -226,5 +261,19 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         write_time.as_secs_f64(),
         t0.elapsed().as_secs_f64()
     );
+    if !loaded.skipped.is_empty() {
+        println!(
+            "skipped {} of {total_files} files (listed above and in summary.json)",
+            loaded.skipped.len()
+        );
+    }
+    let out = args.out.display();
+    if args.no_pictures {
+        println!("results: {out}/summary.json, {out}/<name>.regions.{{txt,ply}}");
+    } else {
+        println!(
+            "results: {out}/summary.json; pictures: {out}/preview.png; viewer: {out}/index.html"
+        );
+    }
     Ok(super::exit_code(loaded.skipped.len(), total_files))
 }

@@ -29,9 +29,9 @@ pub struct SpectrumArgs {
     /// Seed of the Lanczos start block.
     #[arg(long, default_value_t = 0)]
     seed: u64,
-    /// Threads for the solver (0 = all available, 1 = sequential).
+    /// Threads for the solver (0 = all of `--threads`, 1 = sequential).
     #[arg(long, default_value_t = SpectrumOptions::default().threads)]
-    threads: usize,
+    solver_threads: usize,
     /// Maximum Krylov basis size (default: about twice the eigenpairs computed).
     #[arg(long)]
     basis_size: Option<usize>,
@@ -48,7 +48,7 @@ pub fn run(args: SpectrumArgs) -> Result<ExitCode> {
         tolerance: args.tolerance,
         block_size: args.block_size,
         seed: args.seed,
-        threads: args.threads,
+        threads: args.solver_threads,
         basis_size: args.basis_size,
         ..SpectrumOptions::default()
     };

@@ -29,8 +29,10 @@
 mod ground_truth;
 mod group_parts;
 mod label_agreement;
+mod matched_scores;
 mod part_coverage;
 mod part_purity;
+mod rand_index;
 mod read_labels;
 
 pub use ground_truth::GroundTruth;
@@ -38,8 +40,10 @@ pub use group_parts::{PartGroups, group_parts};
 pub use label_agreement::{
     LabelAgreement, PartAgreement, face_label_agreement, label_agreement, vertex_label_agreement,
 };
+pub use matched_scores::{MatchedScores, matched_scores};
 pub use part_coverage::part_coverage;
 pub use part_purity::part_purity;
+pub use rand_index::rand_index;
 pub use read_labels::{parse_labels, read_labels};
 
 use crate::mesh::TriMesh;

@@ -66,6 +66,8 @@ pub struct SkippedInput {
 pub struct CollectionSummary {
     /// Always `"segment"`.
     pub command: &'static str,
+    /// Version of coseg that wrote the file.
+    pub version: &'static str,
     /// The shapes, in graph order.
     pub shapes: Vec<CollectionShape>,
     /// The region tuples, in id order.
@@ -154,6 +156,7 @@ impl CollectionSummary {
             .collect();
         Self {
             command: "segment",
+            version: env!("CARGO_PKG_VERSION"),
             shapes,
             regions,
             area_fraction: seg.alpha,

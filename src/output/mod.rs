@@ -9,10 +9,15 @@
 //! - `OUT/<name>.regions.ply`: the mesh with `red`/`green`/`blue` colours by region and an
 //!   integer `region` vertex property.
 //! - `OUT/summary.json`: the summary, pretty-printed.
+//! - `OUT/index.html`: [`write_viewer`], a self-contained interactive 3D view of the shapes.
+//! - `OUT/preview.png`, `OUT/<name>.png`: pictures ([`crate::render`]); [`write_visuals`]
+//!   writes them and the viewer in one call.
 
 mod collection_summary;
 mod pair_summary;
 mod region_colors;
+mod viewer;
+mod visuals;
 mod write_regions;
 
 pub use collection_summary::{
@@ -20,6 +25,8 @@ pub use collection_summary::{
 };
 pub use pair_summary::{PairSummary, RegionSummary, ShapeSummary};
 pub use region_colors::region_colors;
+pub use viewer::write_viewer;
+pub use visuals::write_visuals;
 pub use write_regions::{
     ShapeRegions, write_region_ids, write_region_mesh, write_regions, write_summary,
 };
@@ -54,6 +61,9 @@ pub enum OutputError {
     /// A shape name that cannot be a file name.
     #[error("invalid shape name {0:?}: must be non-empty without path separators")]
     BadName(String),
+    /// Drawing or writing a picture failed.
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
     /// The summary could not be serialised.
     #[error("summary.json: {0}")]
     Json(String),

@@ -44,6 +44,10 @@ pub struct RegionSummary {
 /// Contents of `summary.json` for `coseg pair`.
 #[derive(Debug, Clone, Serialize)]
 pub struct PairSummary {
+    /// Always `"pair"`.
+    pub command: &'static str,
+    /// Version of coseg that wrote the file.
+    pub version: &'static str,
     /// The two shapes, A then B.
     pub shapes: [ShapeSummary; 2],
     /// The options used.
@@ -107,6 +111,8 @@ impl PairSummary {
             })
             .collect();
         Self {
+            command: "pair",
+            version: env!("CARGO_PKG_VERSION"),
             shapes,
             options: options.clone(),
             refine: None,

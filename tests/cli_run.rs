@@ -1,0 +1,343 @@
+//! The `coseg` binary on temporary folders: skipped files and `--strict`, `--quiet`, pictures,
+//! and a run killed during the per-shape stage then resumed.
+
+mod common;
+
+use common::features::{blob, similarity};
+use coseg::mesh::write_mesh;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+/// Small pipeline settings so that debug builds finish in seconds.
+const FAST: &[&str] = &[
+    "--eigenpairs",
+    "20",
+    "--hks",
+    "6",
+    "--wks",
+    "6",
+    "--curvature",
+    "6",
+    "--bands",
+    "6",
+    "--regions",
+    "3",
+];
+
+fn coseg(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .args(args)
+        .output()
+        .expect("run coseg")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+/// `n` smooth blobs (level-`level` icospheres, 10·4^level + 2 vertices) in `dir`, as OBJ, OFF
+/// and PLY in turn.
+fn shapes(dir: &Path, n: usize, level: usize) {
+    let ext = ["obj", "off", "ply"];
+    for i in 0..n {
+        let mesh = similarity(&blob(level), 1.0 + 0.1 * i as f64);
+        write_mesh(dir.join(format!("s{i}.{}", ext[i % 3])), &mesh, &[]).unwrap();
+    }
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.is_file())
+        .map(|p| {
+            (
+                p.file_name().unwrap().to_string_lossy().into_owned(),
+                std::fs::read(&p).unwrap(),
+            )
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+#[test]
+fn broken_file_is_reported_and_skipped_with_exit_3_and_strict_fails() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 3, 2);
+    std::fs::write(input.join("broken.off"), "OFF\n4 4 0\n0 0 0\n").unwrap();
+    std::fs::write(input.join("notes.txt"), "not a mesh").unwrap();
+    let out = dir.path().join("out");
+    let mut args = vec!["segment", s(&input), "-o", s(&out)];
+    args.extend(FAST);
+    let run = coseg(&args);
+    let (stdout, stderr) = (text(&run.stdout), text(&run.stderr));
+    assert_eq!(run.status.code(), Some(3), "{stdout}{stderr}");
+    assert!(
+        stderr.contains("broken.off") && stderr.contains("skipped"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("notes.txt"), "{stderr}");
+    assert!(stdout.contains("3 shapes co-segmented"), "{stdout}");
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(summary.contains("broken.off"), "{summary}");
+    for name in [
+        "s0.regions.txt",
+        "s1.png",
+        "s2.regions.ply",
+        "preview.png",
+        "index.html",
+    ] {
+        assert!(out.join(name).is_file(), "{name} missing");
+    }
+
+    let strict_out = dir.path().join("strict");
+    let mut args = vec!["--strict", "segment", s(&input), "-o", s(&strict_out)];
+    args.extend(FAST);
+    let run = coseg(&args);
+    let stderr = text(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("broken.off") && stderr.contains("--strict"),
+        "{stderr}"
+    );
+    assert!(!strict_out.join("summary.json").exists());
+}
+
+#[test]
+fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 2, 2);
+    let out = dir.path().join("out");
+    let mut args = vec![
+        "segment",
+        s(&input),
+        "-o",
+        s(&out),
+        "--quiet",
+        "--no-pictures",
+    ];
+    args.extend(FAST);
+    let run = coseg(&args);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    assert!(run.stdout.is_empty(), "{}", text(&run.stdout));
+    assert!(run.stderr.is_empty(), "{}", text(&run.stderr));
+    assert!(out.join("summary.json").is_file());
+    assert!(!out.join("preview.png").exists() && !out.join("index.html").exists());
+
+    let pair_out = dir.path().join("pair");
+    let run = coseg(&[
+        "-q",
+        "pair",
+        s(&input.join("s0.obj")),
+        s(&input.join("s1.off")),
+        "-o",
+        s(&pair_out),
+        "--eigenpairs",
+        "20",
+        "--hks",
+        "6",
+        "--wks",
+        "6",
+        "--curvature",
+        "6",
+        "--bands",
+        "6",
+        "--pairs",
+        "3",
+    ]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    assert!(
+        run.stdout.is_empty() && run.stderr.is_empty(),
+        "{}{}",
+        text(&run.stdout),
+        text(&run.stderr)
+    );
+    // pair caches by default, like segment, and draws its pictures.
+    assert!(std::fs::read_dir(pair_out.join(".cache")).unwrap().count() >= 2);
+    assert!(pair_out.join("preview.png").is_file() && pair_out.join("s0.png").is_file());
+}
+
+#[test]
+fn render_writes_a_png_of_the_expected_size_that_is_not_one_colour() {
+    let dir = tempfile::tempdir().unwrap();
+    shapes(dir.path(), 3, 2);
+    let labels: String = (0..blob(2).vertex_count())
+        .map(|i| format!("{}\n", i % 4))
+        .collect();
+    let lab = dir.path().join("s0.labels.txt");
+    std::fs::write(&lab, labels).unwrap();
+    let png_path = dir.path().join("sheet.png");
+    let run = coseg(&[
+        "render",
+        s(&dir.path().join("s0.obj")),
+        s(&dir.path().join("s1.off")),
+        s(&dir.path().join("s2.ply")),
+        "-o",
+        s(&png_path),
+        "--cell-size",
+        "100",
+        "--columns",
+        "3",
+        "--labels",
+        s(&lab),
+        s(&lab),
+        s(&lab),
+    ]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    let dec = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(&png_path).unwrap(),
+    ));
+    let mut reader = dec.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.width, 300);
+    assert!(info.height > 100, "{}", info.height);
+    let mut colours: Vec<&[u8]> = buf[..info.buffer_size()].chunks(3).collect();
+    colours.sort_unstable();
+    colours.dedup();
+    assert!(colours.len() > 20, "{} colours", colours.len());
+    // A label file of the wrong length is named in the error.
+    std::fs::write(&lab, "0\n1\n").unwrap();
+    let run = coseg(&[
+        "render",
+        s(&dir.path().join("s0.obj")),
+        "--labels",
+        s(&lab),
+        "-o",
+        s(&png_path),
+    ]);
+    assert_eq!(run.status.code(), Some(1));
+    assert!(
+        text(&run.stderr).contains("s0.labels.txt"),
+        "{}",
+        text(&run.stderr)
+    );
+}
+
+fn cache_entries(dir: &Path) -> Vec<PathBuf> {
+    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
+        .map(|r| {
+            r.map(|e| e.unwrap().path())
+                .filter(|p| p.extension().is_some_and(|e| e == "coseg-shape"))
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+#[test]
+fn run_killed_during_per_shape_stage_resumes_to_identical_outputs_redoing_only_the_rest() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    let n = 6;
+    shapes(&input, n, 4);
+    let mut fast: Vec<&str> = FAST.to_vec();
+    fast[1] = "60";
+    // Reference: an uninterrupted run.
+    let reference = dir.path().join("reference");
+    let mut args = vec!["--threads", "1", "segment", s(&input), "-o", s(&reference)];
+    args.extend(&fast);
+    let run = coseg(&args);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+
+    let out = dir.path().join("out");
+    let cache = out.join(".cache");
+    let mut args = vec!["--threads", "1", "segment", s(&input), "-o", s(&out)];
+    args.extend(&fast);
+    let mut child = Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .args(&args)
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    while cache_entries(&cache).is_empty() {
+        assert!(
+            t0.elapsed() < Duration::from_secs(300),
+            "no cache entry after 300 s"
+        );
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the run ended before it could be killed"
+        );
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let done = cache_entries(&cache);
+    assert!(
+        !done.is_empty() && done.len() < n,
+        "killed with {} of {n} shapes cached: not during the per-shape stage",
+        done.len()
+    );
+    assert!(
+        !out.join("summary.json").exists(),
+        "killed before any output"
+    );
+    let stamps: Vec<_> = done
+        .iter()
+        .map(|p| std::fs::metadata(p).unwrap().modified().unwrap())
+        .collect();
+
+    let run = coseg(&args);
+    let stdout = text(&run.stdout);
+    assert_eq!(run.status.code(), Some(0), "{stdout}{}", text(&run.stderr));
+    // Only the unfinished shapes were computed again.
+    assert!(
+        stdout.contains(&format!("({} cached)", done.len())),
+        "{stdout}"
+    );
+    for (p, t) in done.iter().zip(&stamps) {
+        assert_eq!(
+            std::fs::metadata(p).unwrap().modified().unwrap(),
+            *t,
+            "{} rewritten",
+            p.display()
+        );
+    }
+    assert_eq!(cache_entries(&cache).len(), n);
+    let (a, b) = (files(&reference), files(&out));
+    assert_eq!(
+        a.iter().map(|f| &f.0).collect::<Vec<_>>(),
+        b.iter().map(|f| &f.0).collect::<Vec<_>>()
+    );
+    for ((name, x), (_, y)) in a.iter().zip(&b) {
+        assert!(
+            x == y,
+            "{name} differs between the resumed and the uninterrupted run"
+        );
+    }
+}
+
+#[test]
+fn help_shows_an_example_for_every_subcommand_and_the_shared_flags() {
+    let top = text(&coseg(&["--help"]).stdout);
+    assert!(
+        top.contains("Examples:") && top.contains("--quiet") && top.contains("--strict"),
+        "{top}"
+    );
+    for cmd in [
+        "info", "spectrum", "convert", "features", "generate", "pair", "segment", "render", "eval",
+    ] {
+        let out = coseg(&[cmd, "--help"]);
+        let help = text(&out.stdout);
+        assert_eq!(out.status.code(), Some(0), "{cmd}");
+        assert!(
+            help.contains(&format!("coseg {cmd} ")),
+            "{cmd} --help has no example:\n{help}"
+        );
+        assert!(help.contains("--threads"), "{cmd}");
+    }
+}
