@@ -3,9 +3,9 @@
 //! unknown keys rejected so that a typo never passes silently.
 
 use coseg::bands::BandWeighting;
-use coseg::pipeline::ShapePipelineOptions;
 use coseg::graph::{CosegmentOptions, GraphOptions, SegmentCollectionOptions};
 use coseg::maps::{MapPreset, PointMapOptions, PresetChoice, ZoomOutOptions, map_preset};
+use coseg::pipeline::ShapePipelineOptions;
 use coseg::spectral::Spectrum;
 use coseg::stable::{
     Algorithm, AreaReference, Init, MapGuidedOptions, RefineOptions, SegmentPairOptions,
