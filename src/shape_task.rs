@@ -10,11 +10,11 @@
 //! the shapes that are already done.
 
 use crate::cache::{ShapeKey, bands_path, cache_path};
+use crate::mesh::{MeshError, MeshFormat, TriMesh, read_mesh_from_bytes, write_atomic};
 use crate::pipeline::{
     PipelineError, ShapeBands, ShapePipelineOptions, compute_shape_data, decode_bands_entry,
     decode_shape_entry, encode_bands_entry, encode_shape_entry, shape_key,
 };
-use crate::mesh::{MeshError, MeshFormat, TriMesh, read_mesh_from_bytes, write_atomic};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
