@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use coseg::maps::MapGuidedOptions;
 use coseg::maps::ZoomOutOptions;
 use coseg::maps::{
     MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
@@ -9,7 +10,7 @@ use coseg::maps::{
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
 use coseg::pipeline::{PipelineError, ShapeData, load_shape};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions,
+    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
     StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
 };
 use std::path::{Path, PathBuf};
