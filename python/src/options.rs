@@ -107,6 +107,7 @@ impl<'py> Opts<'py> {
                 max_rounds: rounds,
                 smoothing_time: time,
             }),
+            ..d
         })
     }
 
