@@ -6,17 +6,17 @@
 mod options;
 
 use coseg::cache::CacheOutcome;
-use coseg::pipeline::{
-    ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
-};
 use coseg::graph::{SegmentCollectionOptions, ShapeNode, load_collection, segment_collection};
+use coseg::maps::PresetChoice;
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
 use coseg::output::{
     CollectionSummary, PairSummary, ShapeRegions, ShapeSummary, SkippedInput, write_regions,
 };
+use coseg::pipeline::{
+    ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
+};
 use coseg::shape_task;
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
-use coseg::maps::PresetChoice;
 use coseg::stable::{PairShape, segment_pair};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -366,7 +366,7 @@ fn pair<'py>(
             let (da, db) = (&data[0], &data[1]);
             let (options, choice, chosen) = pair_opts.resolve(&da.spectrum, &db.spectrum)?;
             let t = std::time::Instant::now();
-            let regions = segment_pair(
+            let pair = segment_pair(
                 PairShape {
                     mesh: &shapes[0].mesh,
                     spectrum: &da.spectrum,
@@ -380,8 +380,8 @@ fn pair<'py>(
                     descriptors: Some(&db.descriptors.values),
                 },
                 &options,
-            )?
-            .regions;
+            )?;
+            let regions = pair.regions;
             let seconds = t.elapsed().as_secs_f64();
             let summary_shape = |s: &Shape| ShapeSummary {
                 name: s.name.clone(),
@@ -401,7 +401,8 @@ fn pair<'py>(
             .with_map_preset(options.map_guided.as_ref().map(|_| PresetChoice {
                 preset: chosen,
                 discrepancy: choice.discrepancy,
-            }));
+            }))
+            .with_fallbacks(pair.fallbacks);
             Ok((regions, summary))
         })
         .map_err(|e| input_err(e.to_string()))?;

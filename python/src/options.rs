@@ -3,13 +3,15 @@
 //! unknown keys rejected so that a typo never passes silently.
 
 use coseg::bands::BandWeighting;
-use coseg::pipeline::ShapePipelineOptions;
 use coseg::graph::{CosegmentOptions, GraphOptions, SegmentCollectionOptions};
-use coseg::maps::{MapPreset, PointMapOptions, PresetChoice, ZoomOutOptions, map_preset};
+use coseg::maps::{
+    MapGuidedOptions, MapPreset, PointMapOptions, PresetChoice, ZoomOutOptions, map_preset,
+};
+use coseg::pipeline::ShapePipelineOptions;
 use coseg::spectral::Spectrum;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, RefineOptions, SegmentPairOptions,
-    StableError, StableRegionsOptions, TSearch, Threshold,
+    Algorithm, AreaReference, Init, RefineOptions, SegmentPairOptions, StableRegionsOptions,
+    TSearch, Threshold,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -105,6 +107,7 @@ impl<'py> Opts<'py> {
                 max_rounds: rounds,
                 smoothing_time: time,
             }),
+            ..d
         })
     }
 
@@ -199,7 +202,7 @@ impl PairOpts {
         &self,
         a: &Spectrum,
         b: &Spectrum,
-    ) -> Result<(SegmentPairOptions, PresetChoice, MapPreset), StableError> {
+    ) -> Result<(SegmentPairOptions, PresetChoice, MapPreset), coseg::maps::MapError> {
         let choice = map_preset(a, b)?;
         let chosen = self.preset.unwrap_or(choice.preset);
         let preset = chosen.options();
