@@ -9,11 +9,11 @@
 
 use coseg::affinity::BandAffinity;
 use coseg::bands::{BandTable, equal_count_bands};
-use coseg::mesh::TriMesh;
-use coseg::spectral::{
-    AuctionOptions, CandidateLists, ShapeGeometry, SpectrumOptions, ZoomOutOptions,
-    auction_assignment, laplace_beltrami_spectrum, zoomout,
+use coseg::maps::{
+    AuctionOptions, CandidateLists, ShapeGeometry, ZoomOutOptions, auction_assignment, zoomout,
 };
+use coseg::mesh::TriMesh;
+use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 use coseg::stable::{StableRegionsOptions, stable_pairs_fixed};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use std::hint::black_box;

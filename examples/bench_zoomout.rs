@@ -9,9 +9,9 @@
 //! default sizes (10 → 150, 2,000 samples); every configuration is run `R` times (default 3)
 //! and its wall times printed, with the share of vertices mapped to themselves.
 
+use coseg::maps::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
 use coseg::mesh::read_mesh;
 use coseg::pipeline::{ShapePipelineOptions, load_or_compute};
-use coseg::spectral::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
 use std::path::PathBuf;
 use std::time::Instant;
 

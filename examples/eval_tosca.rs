@@ -19,14 +19,15 @@
 
 use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
+use coseg::maps::{FinalMatch, ZoomOutOptions, zoomout};
+use coseg::maps::{MapPreset, ShapeGeometry, map_preset};
 use coseg::mesh::{TriMesh, read_mesh};
 use coseg::pipeline::{ShapeData, ShapePipelineOptions, load_or_compute};
-use coseg::spectral::{FinalMatch, HeatSmoother, ZoomOutOptions, zoomout};
+use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, PairShape, RefineOptions,
-    SegmentPairOptions, ShapeGeometry, StableRegionsOptions, TSearch, VertexMap,
-    correspondence_stats, map_preset, point_map_refinement, refine_regions, segment_pair,
-    stable_regions,
+    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions,
+    StableRegionsOptions, TSearch, VertexMap, correspondence_stats, point_map_refinement,
+    refine_regions, segment_pair, stable_regions,
 };
 use std::path::PathBuf;
 use std::time::Instant;

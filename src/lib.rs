@@ -14,6 +14,7 @@
 //! | features | [`features`] | HKS, WKS and multiscale mean curvature per vertex |
 //! | bands | [`bands`] | per-feature rank bands stored as a compact `u8` table |
 //! | per-shape pipeline | [`pipeline`] | mesh → spectrum → features → bands once per shape, through [`cache`] (storage only); [`pipeline::load_shape`] is the one loader |
+//! | correspondence maps | [`maps`] | functional maps, ZoomOut, one-to-one matches, map presets |
 //! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
@@ -31,6 +32,7 @@ pub mod features;
 pub mod generate;
 pub mod graph;
 pub mod labels;
+pub mod maps;
 pub mod mesh;
 pub mod output;
 pub mod pipeline;

@@ -10,11 +10,12 @@
 mod common;
 
 use common::adversarial::base_sphere;
-use coseg::cache::{
-    CacheOutcome, ShapePipelineOptions, cache_path, compute_shape_data, decode_entry, encode_entry,
+use coseg::cache::{CacheOutcome, cache_path};
+use coseg::mesh::{TriMesh, write_atomic, write_mesh};
+use coseg::pipeline::{
+    ShapePipelineOptions, compute_shape_data, decode_shape_entry, encode_shape_entry,
     load_or_compute, load_or_compute_bands, shape_key,
 };
-use coseg::mesh::{TriMesh, write_atomic, write_mesh};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;

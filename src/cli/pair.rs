@@ -2,14 +2,15 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use coseg::maps::ZoomOutOptions;
+use coseg::maps::{
+    MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
+};
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
 use coseg::pipeline::{PipelineError, ShapeData, load_shape};
-use coseg::spectral::ZoomOutOptions;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY,
-    PairShape, PointMapOptions, PresetChoice, RefineOptions, SegmentPairOptions,
-    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, map_preset,
-    segment_pair,
+    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions,
+    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -101,7 +102,7 @@ pub struct PairArgs {
     /// descriptors in the point map's last match; TOSCA within-class 95.7 % against 94.3 %,
     /// but worse on different bodies), `general`, or `auto`, which picks `near-isometric`
     /// when the two spectra agree (eigenvalue discrepancy below 0.03, see
-    /// `coseg::stable::map_preset`).
+    /// `coseg::maps::map_preset`).
     #[arg(long, value_enum, default_value = "auto")]
     map_preset: MapPresetArg,
     /// Same as `--map-preset near-isometric`.

@@ -1,8 +1,8 @@
 //! [`PairSummary`]: the `summary.json` of a two-shape stable-region run.
 
+use crate::maps::PresetChoice;
 use crate::stable::{
-    MapGuidedOptions, PresetChoice, RefineOptions, StableRegions, StableRegionsOptions,
-    StageFallback,
+    MapGuidedOptions, RefineOptions, StableRegions, StableRegionsOptions, StageFallback,
 };
 use serde::Serialize;
 
@@ -56,7 +56,7 @@ pub struct PairSummary {
     /// [`map_guided_refinement`](crate::stable::map_guided_refinement)).
     pub map_guided: Option<MapGuidedOptions>,
     /// Which preset the map step's options came from and the pair's eigenvalue discrepancy
-    /// (see [`map_preset`](crate::stable::map_preset)), when the step ran.
+    /// (see [`map_preset`](crate::maps::map_preset)), when the step ran.
     pub map_preset: Option<PresetChoice>,
     /// The requested optional stages (`refine`, `map_guided`) that could not run on these
     /// shapes and left the previous stage's regions, each with the reason; empty when every

@@ -2,11 +2,11 @@
 //! affinity together with a point map read from the region correspondence itself.
 
 use super::refine_regions::rebuild_regions;
-use super::{
-    MapShape, PointMapOptions, StableError, StableRegions, region_point_map, region_scores,
-};
+use super::{StableError, StableRegions, region_scores};
 use crate::affinity::{BandAffinity, Direction};
-use crate::spectral::{HeatSmoother, ShapeGeometry};
+use crate::maps::ShapeGeometry;
+use crate::maps::{MapShape, PointMapOptions, region_point_map};
+use crate::spectral::HeatSmoother;
 use serde::{Deserialize, Serialize};
 
 /// Options of [`map_guided_refinement`].
@@ -27,7 +27,7 @@ pub struct MapGuidedOptions {
 impl MapGuidedOptions {
     /// The map step for near-isometric pairs (two poses of one body): a vote of weight 2 and
     /// a point map whose last match also compares the descriptors (weight 500, see
-    /// [`ZoomOutOptions::descriptor_weight`](crate::spectral::ZoomOutOptions)). On the TOSCA
+    /// [`ZoomOutOptions::descriptor_weight`](crate::maps::ZoomOutOptions)). On the TOSCA
     /// within-class pairs it scores best (94.6 % against 94.0 % for the default, README); on
     /// shapes that are not near-isometric it trusts the map too much (the shipped quadruped
     /// pair loses 4 points of part purity), hence not the default.
@@ -77,6 +77,7 @@ impl Default for MapGuidedOptions {
 /// use coseg::pipeline::{compute_shape_data, ShapePipelineOptions};
 /// use coseg::mesh::read_mesh;
 /// use coseg::spectral::HeatSmoother;
+/// use coseg::maps::{MapShape, PointMapOptions, ShapeGeometry};
 /// use coseg::stable::*;
 /// let (ma, mb) = (read_mesh("cat0.off")?, read_mesh("cat1.off")?);
 /// let pipe = ShapePipelineOptions::default();
@@ -156,7 +157,7 @@ pub fn map_guided_refinement(
 
 /// The blend of [`map_guided_refinement`] with a point map `map` from B to A given by the
 /// caller (`map[q]` is a vertex of A for every vertex `q` of B), for instance one from
-/// another correspondence method or [`zoomout`](crate::spectral::zoomout) from a known map.
+/// another correspondence method or [`zoomout`](crate::maps::zoomout) from a known map.
 /// `areas_a`, `areas_b` are the vertex areas the rebuilt pairs' area fractions use; `β` is
 /// `map_weight`.
 ///

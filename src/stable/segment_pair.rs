@@ -7,13 +7,14 @@ use super::{
 };
 use crate::affinity::BandAffinity;
 use crate::bands::BandTable;
+use crate::maps::ShapeGeometry;
 use crate::mesh::TriMesh;
-use crate::spectral::{HeatSmoother, ShapeGeometry, Spectrum};
+use crate::spectral::{HeatSmoother, Spectrum};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 /// Options of [`segment_pair`]. The defaults suit any pair; `coseg pair` replaces the map
-/// step's options by those [`map_preset`](super::map_preset) picks from the two spectra
+/// step's options by those [`map_preset`](crate::maps::map_preset) picks from the two spectra
 /// (`MapPreset::options`), which on two poses of one body is the configuration that scores
 /// best on the TOSCA within-class pairs (README, "Correspondence ratio").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -50,7 +51,7 @@ pub struct PairShape<'a> {
     /// Its `d × N` band table.
     pub bands: &'a BandTable,
     /// Its descriptors, feature-major (`Descriptors::values`); optional, they sharpen the map
-    /// step's point map (see [`ZoomOutOptions::descriptor_weight`](crate::spectral::ZoomOutOptions)).
+    /// step's point map (see [`ZoomOutOptions::descriptor_weight`](crate::maps::ZoomOutOptions)).
     pub descriptors: Option<&'a [f64]>,
 }
 

@@ -1,7 +1,8 @@
 //! [`map_preset`]: which map-step options suit a pair, from how near-isometric it is.
 
-use super::{MapGuidedOptions, StableError};
-use crate::spectral::{Spectrum, eigenvalue_discrepancy};
+use super::eigenvalue_discrepancy;
+use crate::spectral::Spectrum;
+use crate::stable::{MapGuidedOptions, StableError};
 use serde::{Deserialize, Serialize};
 
 /// Eigenvalues compared by [`map_preset`] (`λ_1 … λ_19`).
@@ -55,7 +56,7 @@ pub struct PresetChoice {
 /// ```
 /// use coseg::mesh::TriMesh;
 /// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions};
-/// use coseg::stable::{map_preset, MapPreset};
+/// use coseg::maps::{map_preset, MapPreset};
 /// let n = 9u32;
 /// let pos = (0..n * n).map(|i| [(i % n) as f64, (i / n) as f64, 0.0]).collect();
 /// let mut faces = Vec::new();

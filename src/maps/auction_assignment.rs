@@ -2,7 +2,7 @@
 //! candidate lists (Bertsekas' auction algorithm), used by
 //! [`zoomout`](super::zoomout) to read its last point map.
 
-use super::SpectralError;
+use crate::spectral::SpectralError;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
@@ -80,7 +80,7 @@ pub struct Assignment {
 /// query bids above its outside option.
 ///
 /// ```
-/// use coseg::spectral::{auction_assignment, AuctionOptions, CandidateLists};
+/// use coseg::maps::{auction_assignment, AuctionOptions, CandidateLists};
 /// // Two queries whose nearest target is 0; query 1 has target 1 almost as near.
 /// let lists = CandidateLists { per_query: 2, targets: vec![0, 1, 0, 1], costs: vec![1.0, 5.0, 1.0, 1.5] };
 /// let out = auction_assignment(&lists, 2, &AuctionOptions::default()).unwrap();

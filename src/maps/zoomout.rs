@@ -1,14 +1,15 @@
 //! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
 //! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
 
-use super::{AuctionOptions, CandidateLists, SpectralError, Spectrum, auction_assignment};
+use super::{AuctionOptions, CandidateLists, auction_assignment};
+use crate::spectral::{SpectralError, Spectrum};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatRef, Par};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
 /// Options of [`zoomout`] (and of the ZoomOut stage of
-/// [`region_point_map`](crate::stable::region_point_map)).
+/// [`region_point_map`](crate::maps::region_point_map)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ZoomOutOptions {
     /// Size `k₀` of the first functional map (default 10).
@@ -105,7 +106,8 @@ pub struct ShapeGeometry<'a> {
 ///
 /// ```
 /// use coseg::mesh::TriMesh;
-/// use coseg::spectral::{laplace_beltrami_spectrum, zoomout, ShapeGeometry, SpectrumOptions, ZoomOutOptions};
+/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions};
+/// use coseg::maps::{ShapeGeometry, ZoomOutOptions, zoomout};
 /// // A 9 × 3 grid of points.
 /// let (nx, ny) = (9u32, 3u32);
 /// let pos: Vec<[f64; 3]> = (0..nx * ny).map(|i| [(i % nx) as f64, (i / nx) as f64, 0.0]).collect();

@@ -2,9 +2,10 @@
 //! corresponding regions, through a functional map fitted to the region indicators and refined
 //! spectrally (ZoomOut).
 
-use super::StableError;
-use crate::spectral::zoomout::{eigenvectors, validate, zoomout_from};
-use crate::spectral::{ShapeGeometry, Spectrum, ZoomOutOptions};
+use super::zoomout::{eigenvectors, validate, zoomout_from};
+use super::{ShapeGeometry, ZoomOutOptions};
+use crate::spectral::Spectrum;
+use crate::stable::StableError;
 use faer::MatRef;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -60,8 +61,9 @@ pub struct MapShape<'a> {
 ///
 /// ```
 /// use coseg::mesh::TriMesh;
-/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions, ZoomOutOptions};
-/// use coseg::stable::{region_point_map, MapShape, PointMapOptions};
+/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions};
+/// use coseg::maps::ZoomOutOptions;
+/// use coseg::maps::{region_point_map, MapShape, PointMapOptions};
 /// // A strip of 8 × 2 squares, cut into left and right halves.
 /// let (nx, ny) = (9u32, 3u32);
 /// let pos: Vec<[f64; 3]> = (0..nx * ny).map(|i| [(i % nx) as f64, (i / nx) as f64, 0.0]).collect();
