@@ -19,13 +19,14 @@
 
 use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
+use coseg::maps::MapGuidedOptions;
 use coseg::maps::{FinalMatch, ZoomOutOptions, zoomout};
 use coseg::maps::{MapPreset, ShapeGeometry, map_preset};
 use coseg::mesh::{TriMesh, read_mesh};
 use coseg::pipeline::{ShapeData, ShapePipelineOptions, load_or_compute};
 use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions,
+    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
     StableRegionsOptions, TSearch, VertexMap, correspondence_stats, point_map_refinement,
     refine_regions, segment_pair, stable_regions,
 };

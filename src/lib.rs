@@ -22,6 +22,7 @@
 //! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
+//! | per-shape task | [`shape_task`] | the per-shape stage as bytes in, cache entry bytes out (for distributed engines) |
 #![deny(missing_docs)]
 
 pub mod affinity;
@@ -36,5 +37,6 @@ pub mod maps;
 pub mod mesh;
 pub mod output;
 pub mod pipeline;
+pub mod shape_task;
 pub mod spectral;
 pub mod stable;

@@ -342,3 +342,123 @@ fn user_csv_header_names_columns_and_errors_name_the_file() {
     let missing = read_user_features(&dir.path().join("nope.csv"), 2).unwrap_err();
     assert!(missing.to_string().contains("nope.csv"));
 }
+
+// ---- families in the per-shape pipeline ----
+
+fn small_pipeline() -> coseg::pipeline::ShapePipelineOptions {
+    let mut o = coseg::pipeline::ShapePipelineOptions::default();
+    o.spectrum.eigenpairs = 12;
+    o.descriptors.hks_count = 4;
+    o.descriptors.wks_count = 4;
+    o.descriptors.curvature_count = 4;
+    o.bands.bands = 5;
+    o
+}
+
+#[test]
+fn user_features_round_trip_exactly_through_the_cache() {
+    use coseg::cache::CacheOutcome;
+    use coseg::features::{FeatureFamilies, UserSource};
+    use coseg::pipeline::load_or_compute;
+    let dir = tempfile::tempdir().unwrap();
+    let m = blob(1);
+    let d = m.vertex_count();
+    // Values that print long and widen from f32 oddly, to catch any lossy step.
+    let f0: Vec<f64> = (0..d).map(|v| (v as f64 * 0.731).sin() / 3.0).collect();
+    let f1: Vec<f64> = (0..d).map(|v| 1e-300 * v as f64 - 7.0).collect();
+    let c_order: Vec<f64> = (0..d).flat_map(|v| [f0[v], f1[v]]).collect();
+    let npy = dir.path().join("feats").join("blob.npy");
+    std::fs::create_dir_all(npy.parent().unwrap()).unwrap();
+    write_npy_f64(&npy, d as u64, 2, &c_order, false);
+    let mut o = small_pipeline();
+    let mut fam = FeatureFamilies::default();
+    fam.user = Some(UserSource::Dir(npy.parent().unwrap().to_path_buf()));
+    o.families = fam
+        .for_shape(std::path::Path::new("somewhere/blob.off"))
+        .unwrap();
+    let cache = dir.path().join("cache");
+    let first = load_or_compute(&m, &o, &cache).unwrap();
+    let second = load_or_compute(&m, &o, &cache).unwrap();
+    assert_eq!(second.outcome, CacheOutcome::Hit);
+    assert_eq!(first.data, second.data);
+    let t = &second.data.descriptors;
+    assert_eq!(t.extra_names, ["user_000", "user_001"]);
+    let s = t.spectral_count();
+    assert_eq!(t.feature(s), &f0[..]);
+    assert_eq!(t.feature(s + 1), &f1[..]);
+    // Another file content is another key: the cache never serves stale user features.
+    let mut changed = c_order.clone();
+    changed[0] += 1.0;
+    write_npy_f64(&npy, d as u64, 2, &changed, false);
+    o.families = fam.for_shape(std::path::Path::new("blob.off")).unwrap();
+    let third = load_or_compute(&m, &o, &cache).unwrap();
+    assert_eq!(third.outcome, CacheOutcome::Miss);
+    assert_eq!(third.data.descriptors.feature(s)[0], f0[0] + 1.0);
+}
+
+#[test]
+fn a_missing_user_file_names_the_folder_and_the_shape() {
+    use coseg::features::{FeatureFamilies, UserSource};
+    let dir = tempfile::tempdir().unwrap();
+    let mut fam = FeatureFamilies::default();
+    fam.user = Some(UserSource::Dir(dir.path().to_path_buf()));
+    let e = fam
+        .for_shape(std::path::Path::new("x/chair7.off"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("chair7.npy") && e.contains("chair7.off"), "{e}");
+}
+
+#[test]
+fn a_collection_mixing_families_is_deterministic_bit_for_bit() {
+    use coseg::features::{FeatureFamilies, parse_families};
+    use coseg::graph::{SegmentCollectionOptions, ShapeNode, segment_collection};
+    use coseg::pipeline::compute_shape_data;
+    let meshes = [blob(2), similarity(&blob(2), 2.0), icosphere(2)];
+    let mut o = small_pipeline();
+    let (_, fam): (bool, FeatureFamilies) =
+        parse_families("spectral,extrinsic,sdf", Alignment::Pca).unwrap();
+    o.families = fam;
+    o.families.weights.sdf = 2.0;
+    let run = || {
+        let nodes: Vec<ShapeNode> = meshes
+            .iter()
+            .enumerate()
+            .map(|(i, m)| {
+                let d = compute_shape_data(m, &o).unwrap();
+                ShapeNode::new(format!("s{i}"), d.bands, &d.descriptors.vertex_areas).unwrap()
+            })
+            .collect();
+        let features = nodes[0].bands.features;
+        let mut s = SegmentCollectionOptions::default();
+        s.cosegment.regions = 3;
+        s.feature_weights = o.feature_weights(features);
+        assert!(s.feature_weights.is_some());
+        let out = segment_collection(nodes.clone(), &meshes, &s).unwrap();
+        (
+            nodes,
+            (0..3)
+                .map(|i| out.segmentation.labels(i))
+                .collect::<Vec<_>>(),
+        )
+    };
+    let (na, la) = run();
+    let (nb, lb) = run();
+    assert_eq!(na, nb);
+    assert_eq!(la, lb);
+    // 12 spectral + 102 extrinsic + 3 sdf columns.
+    assert_eq!(na[0].bands.features, 12 + 102 + 3);
+}
+
+#[test]
+fn family_weights_give_each_family_its_total_share() {
+    let mut o = small_pipeline();
+    let (_, fam) = coseg::features::parse_families("spectral,sdf", Alignment::Pca).unwrap();
+    o.families = fam;
+    o.families.weights.sdf = 3.0;
+    let w = o.feature_weights(12 + 3).unwrap();
+    let spectral: f64 = w[..12].iter().sum();
+    let sdf: f64 = w[12..].iter().sum();
+    assert!((spectral - 1.0).abs() < 1e-12 && (sdf - 3.0).abs() < 1e-12);
+    assert_eq!(small_pipeline().feature_weights(12), None);
+}

@@ -38,10 +38,12 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
     for w in &report.warnings {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
-    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &args.pipeline.options()) {
+    let mut opts = args.pipeline.options()?;
+    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &opts) {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
-    let opts = args.pipeline.options();
+    // User features are per shape: resolve the folder to this mesh's file.
+    opts.families = opts.families.for_shape(&args.mesh)?;
     let data = match &args.cache {
         Some(dir) => {
             let r = load_or_compute(&mesh, &opts, dir)

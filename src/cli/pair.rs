@@ -2,6 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
+use coseg::maps::MapGuidedOptions;
 use coseg::maps::ZoomOutOptions;
 use coseg::maps::{
     MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
@@ -9,7 +10,7 @@ use coseg::maps::{
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
 use coseg::pipeline::{PipelineError, ShapeData, load_shape};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, PairShape, RefineOptions, SegmentPairOptions,
+    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
     StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
 };
 use std::path::{Path, PathBuf};
@@ -128,7 +129,7 @@ fn stem(p: &Path) -> String {
 }
 
 pub fn run(args: PairArgs) -> Result<ExitCode> {
-    let pipe = args.pipeline.options();
+    let pipe = args.pipeline.options()?;
     let mut loaded = Vec::new();
     for path in [&args.a, &args.b] {
         let shape = match load_shape::<ShapeData>(path, &pipe, args.cache.as_deref()) {

@@ -2,6 +2,7 @@
 
 use clap::Args;
 use coseg::bands::BandWeighting;
+use coseg::features::{parse_alignment, parse_families, parse_family_weights};
 use coseg::pipeline::ShapePipelineOptions;
 
 #[derive(Debug, Args)]
@@ -24,12 +25,33 @@ pub struct PipelineArgs {
     /// Cut bands by equal area instead of equal vertex count.
     #[arg(long)]
     area_bands: bool,
+    /// Feature families, comma-separated: spectral, extrinsic, sdf, user:DIR (DIR holds
+    /// <mesh stem>.npy or .csv per shape). See docs/FEATURES.md.
+    #[arg(long, default_value = "spectral")]
+    features: String,
+    /// Frame of the extrinsic family: the collection's up axis (x, y, z, -x, …) when it is
+    /// already aligned, or pca.
+    #[arg(long, default_value = "y")]
+    up: String,
+    /// Number of height directions of the extrinsic family.
+    #[arg(long, default_value_t = 100)]
+    directions: usize,
+    /// Family weights in the affinity, e.g. spectral=1,extrinsic=2 (a family's total share;
+    /// default 1 each). Used by `coseg segment`; `coseg pair` weights every column equally.
+    #[arg(long, default_value = "")]
+    family_weights: String,
 }
 
 impl PipelineArgs {
     /// The library options these flags select (library defaults for everything else).
-    pub fn options(&self) -> ShapePipelineOptions {
+    pub fn options(&self) -> anyhow::Result<ShapePipelineOptions> {
         let mut opts = ShapePipelineOptions::default();
+        let (spectral, mut families) = parse_families(&self.features, parse_alignment(&self.up)?)?;
+        if let Some(e) = families.extrinsic.as_mut() {
+            e.directions = self.directions;
+        }
+        parse_family_weights(&self.family_weights, &mut families.weights)?;
+        opts.families = families;
         opts.spectrum.eigenpairs = self.eigenpairs;
         opts.descriptors.hks_count = self.hks;
         opts.descriptors.wks_count = self.wks;
@@ -38,6 +60,11 @@ impl PipelineArgs {
         if self.area_bands {
             opts.bands.weighting = BandWeighting::Area;
         }
-        opts
+        if !spectral {
+            opts.descriptors.hks_count = 0;
+            opts.descriptors.wks_count = 0;
+            opts.descriptors.curvature_count = 0;
+        }
+        Ok(opts)
     }
 }

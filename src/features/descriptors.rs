@@ -85,12 +85,47 @@ pub struct Descriptors {
     pub vertex_areas: Vec<f64>,
     /// `N × d` values, feature-major: `values[f * d + v]`.
     pub values: Vec<f64>,
+    /// Names of the columns of the other families, appended after the spectral ones (see
+    /// [`FeatureFamilies`](super::FeatureFamilies)); empty for a spectral-only table.
+    #[serde(default)]
+    pub extra_names: Vec<String>,
+    /// How many of the extra columns each family gave: `[extrinsic, sdf, user]`.
+    #[serde(default)]
+    pub family_counts: [usize; 3],
 }
 
 impl Descriptors {
     /// Number of features `N`.
     pub fn feature_count(&self) -> usize {
+        self.spectral_count() + self.extra_names.len()
+    }
+
+    /// Number of spectral features (HKS + WKS + curvature), the first columns.
+    pub fn spectral_count(&self) -> usize {
         self.hks_times.len() + self.wks_energies.len() + self.curvature_times.len()
+    }
+
+    /// Appends the columns of other families (`counts` = `[extrinsic, sdf, user]` column
+    /// counts, as [`FeatureFamilies::columns`](super::FeatureFamilies::columns) gives them).
+    pub fn append(
+        &mut self,
+        extra: super::FeatureColumns,
+        counts: [usize; 3],
+    ) -> Result<(), FeatureError> {
+        if extra.vertices != self.vertices || counts.iter().sum::<usize>() != extra.len() {
+            return Err(FeatureError::Inconsistent(format!(
+                "{} extra columns on {} vertices for a table of {} vertices",
+                extra.len(),
+                extra.vertices,
+                self.vertices
+            )));
+        }
+        self.values.extend(extra.values);
+        self.extra_names.extend(extra.names);
+        for (c, n) in self.family_counts.iter_mut().zip(counts) {
+            *c += n;
+        }
+        Ok(())
     }
 
     /// Feature `f` (length `d`).
@@ -122,6 +157,7 @@ impl Descriptors {
         ] {
             names.extend((0..n).map(|i| format!("{fam}_{i:03}")));
         }
+        names.extend(self.extra_names.iter().cloned());
         names
     }
 }
@@ -210,5 +246,7 @@ pub fn descriptors(
         curvature_times: grid.curvature_times,
         vertex_areas: spectrum.vertex_areas.clone(),
         values,
+        extra_names: Vec::new(),
+        family_counts: [0; 3],
     })
 }

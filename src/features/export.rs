@@ -90,8 +90,18 @@ pub fn export_features(
         "features": n,
         "bands": bands.bands,
         "names": names,
-        "kinds": descriptors.kinds().iter().map(|k| k.family()).collect::<Vec<_>>(),
-        "scales": descriptors.kinds().iter().map(|k| k.scale()).collect::<Vec<_>>(),
+        "kinds": descriptors
+            .kinds()
+            .iter()
+            .map(|k| k.family().to_string())
+            .chain(descriptors.extra_names.iter().map(|n| extra_family(n)))
+            .collect::<Vec<_>>(),
+        "scales": descriptors
+            .kinds()
+            .iter()
+            .map(|k| Some(k.scale()))
+            .chain(descriptors.extra_names.iter().map(|_| None))
+            .collect::<Vec<_>>(),
         "hks_times": descriptors.hks_times,
         "wks_energies": descriptors.wks_energies,
         "wks_sigma": descriptors.wks_sigma,
@@ -168,4 +178,9 @@ fn csv<T: std::fmt::Display>(data: &[T], cols: usize, names: &[String]) -> Vec<u
         s.push('\n');
     }
     s.into_bytes()
+}
+
+/// The family of an extra column from its name: `ext`, `sdf` or `user`.
+fn extra_family(name: &str) -> String {
+    name.split(['_', ':']).next().unwrap_or(name).to_string()
 }

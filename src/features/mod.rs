@@ -20,6 +20,7 @@ mod columns;
 mod descriptors;
 mod export;
 mod extrinsic;
+mod families;
 mod heat_kernel_signature;
 mod mean_curvature;
 mod multiscale_mean_curvature;
@@ -34,6 +35,10 @@ pub use descriptors::{DescriptorOptions, Descriptors, FeatureKind, descriptors};
 pub use export::{ExportFormat, ExportOptions, export_features};
 pub use extrinsic::{
     Alignment, Axis, ExtrinsicOptions, Frame, extrinsic_features, height_directions, shape_frame,
+};
+pub use families::{
+    FamilyWeights, FeatureFamilies, UserSource, parse_alignment, parse_families,
+    parse_family_weights,
 };
 pub use heat_kernel_signature::heat_kernel_signature;
 pub use mean_curvature::mean_curvature;

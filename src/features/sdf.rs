@@ -272,19 +272,19 @@ fn nearest_hit(
     let ray = Ray::new(*origin, *dir);
     let mut best: Option<f64> = None;
     for tri in bvh.nearest_traverse_iterator(&ray, tris) {
-        if let (Some(b), Some((entry, _))) = (best, ray.intersection_slice_for_aabb(&tri.aabb())) {
-            if entry > b {
-                break;
-            }
+        if let (Some(b), Some((entry, _))) = (best, ray.intersection_slice_for_aabb(&tri.aabb()))
+            && entry > b
+        {
+            break;
         }
         // Only walls seen from the inside count: the hit face's outward normal goes along the ray.
         if tri.normal.dot(dir) <= 0.0 {
             continue;
         }
-        if let Some(t) = hit_distance(origin, dir, tri, eps) {
-            if best.is_none_or(|b| t < b) {
-                best = Some(t);
-            }
+        if let Some(t) = hit_distance(origin, dir, tri, eps)
+            && best.is_none_or(|b| t < b)
+        {
+            best = Some(t);
         }
     }
     best

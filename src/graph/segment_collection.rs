@@ -2,7 +2,10 @@
 //! [`cosegment`] → heat smoothers → [`refine_cosegmentation`]), as `coseg segment` runs it.
 
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
-use super::{CosegmentOptions, Cosegmentation, GraphError, cosegment, refine_cosegmentation};
+use super::{
+    AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
+    adaptive_cosegment, cosegment, refine_cosegmentation,
+};
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
 use crate::stable::RefineOptions;
@@ -19,6 +22,14 @@ pub struct SegmentCollectionOptions {
     /// Boundary refinement after the co-segmentation; `None` keeps the raw region tuples.
     /// Default: [`SegmentCollectionOptions::DEFAULT_REFINE`].
     pub refine: Option<RefineOptions>,
+    /// Per-feature affinity weights on every edge (`None`: equal weights), e.g. the feature
+    /// families' weights ([`crate::pipeline::ShapePipelineOptions::feature_weights`]).
+    pub feature_weights: Option<Vec<f64>>,
+    /// `Some`: parts of their own size by [`super::adaptive_cosegment`] (then cut at
+    /// [`AdaptiveOptions::parts`] parts when set) instead of [`cosegment`]'s equal areas;
+    /// `cosegment` is ignored. Default `None`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub parts: Option<AdaptiveOptions>,
 }
 
 impl SegmentCollectionOptions {
@@ -39,6 +50,8 @@ impl Default for SegmentCollectionOptions {
             graph: GraphOptions::default(),
             cosegment: CosegmentOptions::default(),
             refine: Some(Self::DEFAULT_REFINE),
+            feature_weights: None,
+            parts: None,
         }
     }
 }
@@ -65,6 +78,8 @@ pub struct SegmentedCollection {
     pub segmentation: Cosegmentation,
     /// Per-stage wall times.
     pub times: SegmentTimes,
+    /// The adaptive run (finest parts, thresholds, tree) when `options.parts` was set.
+    pub adaptive: Option<AdaptiveCosegmentation>,
 }
 
 /// Co-segments a collection: builds the shape graph over `nodes`, extracts consistent region
@@ -115,10 +130,19 @@ pub fn segment_collection(
     }
     let mut times = SegmentTimes::default();
     let t = Instant::now();
-    let graph = ShapeGraph::build(nodes, &options.graph)?;
+    let mut graph = ShapeGraph::build(nodes, &options.graph)?;
+    if options.feature_weights.is_some() {
+        graph.set_feature_weights(options.feature_weights.clone())?;
+    }
     times.graph = t.elapsed();
     let t = Instant::now();
-    let mut segmentation = cosegment(&graph, &options.cosegment)?;
+    let (mut segmentation, adaptive) = match &options.parts {
+        None => (cosegment(&graph, &options.cosegment)?, None),
+        Some(p) => {
+            let a = adaptive_cosegment(&graph, p)?;
+            (a.cut(p.parts.unwrap_or(usize::MAX)), Some(a))
+        }
+    };
     times.cosegment = t.elapsed();
     if let Some(refine) = options.refine.as_ref().filter(|r| r.max_rounds > 0) {
         let t = Instant::now();
@@ -148,5 +172,6 @@ pub fn segment_collection(
         graph,
         segmentation,
         times,
+        adaptive,
     })
 }

@@ -1,9 +1,8 @@
 //! [`PairSummary`]: the `summary.json` of a two-shape stable-region run.
 
+use crate::maps::MapGuidedOptions;
 use crate::maps::PresetChoice;
-use crate::stable::{
-    MapGuidedOptions, RefineOptions, StableRegions, StableRegionsOptions, StageFallback,
-};
+use crate::stable::{RefineOptions, StableRegions, StableRegionsOptions, StageFallback};
 use serde::Serialize;
 
 /// One shape of a pair run.

@@ -250,6 +250,11 @@ pub fn load_shape<T: ShapeContent>(
         warnings.push(format!("{}: {w}", path.display()));
     }
     let t = Instant::now();
+    // User features are per shape: resolve the folder to this shape's file (and its hash).
+    let options = &ShapePipelineOptions {
+        families: options.families.for_shape(path)?,
+        ..options.clone()
+    };
     let (data, outcome, more) = T::obtain(&mesh, options, cache_dir)?;
     warnings.extend(more);
     Ok(LoadedShape {

@@ -3,7 +3,7 @@
 
 use crate::bands::{BandError, BandOptions, BandTable, band_table};
 use crate::cache::{EntryKind, ShapeKey, decode_entry, encode_entry, entry_key};
-use crate::features::{DescriptorOptions, Descriptors, FeatureError, descriptors};
+use crate::features::{DescriptorOptions, Descriptors, FeatureError, FeatureFamilies, descriptors};
 use crate::mesh::{MeshError, TriMesh};
 use crate::spectral::{
     SpectralError, Spectrum, SpectrumOptions, available_eigenpairs, laplace_beltrami_spectrum,
@@ -45,6 +45,25 @@ pub struct ShapePipelineOptions {
     pub descriptors: DescriptorOptions,
     /// Bands (default: `K = 20`, equal counts).
     pub bands: BandOptions,
+    /// Feature families beyond the spectral one, and their weights (default: none).
+    pub families: FeatureFamilies,
+}
+
+impl ShapePipelineOptions {
+    /// Per-column affinity weights for a feature table of `features` columns made under these
+    /// options ([`FeatureFamilies::feature_weights`]; the user family's count is what remains
+    /// after the others). `None`: one family, equal weights.
+    pub fn feature_weights(&self, features: usize) -> Option<Vec<f64>> {
+        let d = &self.descriptors;
+        let spectral = d.hks_count + d.wks_count + d.curvature_count;
+        let f = &self.families;
+        let ext = f.extrinsic.as_ref().map_or(0, |e| {
+            e.directions + usize::from(e.centroid_distance) + usize::from(e.axis_distance)
+        });
+        let sdf = f.sdf.as_ref().map_or(0, |s| s.smoothing_rounds.len());
+        let user = features.saturating_sub(spectral + ext + sdf);
+        f.feature_weights(spectral, [ext, sdf, user])
+    }
 }
 
 /// Everything coseg computes once per shape.
@@ -269,7 +288,11 @@ pub fn shape_data_from_spectrum(
     spectrum: Spectrum,
     options: &ShapePipelineOptions,
 ) -> Result<ShapeData, PipelineError> {
-    let descriptors = descriptors(mesh, &spectrum, &options.descriptors)?;
+    let mut descriptors = descriptors(mesh, &spectrum, &options.descriptors)?;
+    if options.families != FeatureFamilies::default() {
+        let (extra, counts) = options.families.columns(mesh)?;
+        descriptors.append(extra, counts)?;
+    }
     let bands = band_table(&descriptors, &options.bands)?;
     Ok(ShapeData {
         key: shape_key(mesh, options),

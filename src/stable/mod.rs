@@ -30,7 +30,7 @@ pub use correspondence_ratio::{
     CorrespondenceStats, VertexMap, correspondence_ratio, correspondence_stats,
 };
 pub use initial_indicator::{Init, initial_indicator};
-pub use map_guided_refinement::{MapGuidedOptions, map_guided_refinement, point_map_refinement};
+pub use map_guided_refinement::{map_guided_refinement, point_map_refinement};
 pub use refine_partition::{
     RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
 };
@@ -81,6 +81,9 @@ pub enum StableError {
     /// The spectral stage (a smoother or a spectral map) rejected its input.
     #[error(transparent)]
     Spectral(#[from] crate::spectral::SpectralError),
+    /// The correspondence-map stage rejected its input.
+    #[error(transparent)]
+    Map(#[from] crate::maps::MapError),
     /// A ground-truth map is malformed or unreadable (names the file when there is one).
     #[error("ground-truth map: {0}")]
     BadMap(String),

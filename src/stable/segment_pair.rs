@@ -2,11 +2,12 @@
 //! [`refine_regions`] → [`map_guided_refinement`]), as `coseg pair` runs it.
 
 use super::{
-    MapGuidedOptions, RefineOptions, StableError, StableRegions, StableRegionsOptions,
-    map_guided_refinement, refine_regions, stable_regions,
+    RefineOptions, StableError, StableRegions, StableRegionsOptions, map_guided_refinement,
+    refine_regions, stable_regions,
 };
 use crate::affinity::BandAffinity;
 use crate::bands::BandTable;
+use crate::maps::MapGuidedOptions;
 use crate::maps::ShapeGeometry;
 use crate::mesh::TriMesh;
 use crate::spectral::{HeatSmoother, Spectrum};
