@@ -78,6 +78,9 @@ fn dots(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
     out
 }
 
+/// A query and its nearest rows, as `(‖a‖² − 2 a·q, a)` pairs, nearest first.
+type Neighbours = (u32, Vec<(f64, u32)>);
+
 /// Keeps the `count` smallest `(d, index)` pairs of a stream, sorted ascending.
 struct TopK {
     count: usize,
@@ -260,7 +263,7 @@ fn clustered_candidates(
     for run in by_centre.chunk_by(|x, y| x.0 == y.0) {
         groups.extend(run.chunks(GROUP_SIZE));
     }
-    let per_group: Vec<Vec<(u32, Vec<(f64, u32)>)>> = groups
+    let per_group: Vec<Vec<Neighbours>> = groups
         .par_iter()
         .map(|group| search_group(base, query, &norms, &c, &probes, group, count))
         .collect();
@@ -299,7 +302,7 @@ fn search_group(
     probes: &[Vec<u32>],
     group: &[(u32, u32)],
     count: usize,
-) -> Vec<(u32, Vec<(f64, u32)>)> {
+) -> Vec<Neighbours> {
     let dim = base.ncols();
     let rows = Mat::from_fn(group.len(), dim, |i, j| query[(group[i].1 as usize, j)]);
     let clusters = c.members.len();
@@ -366,12 +369,12 @@ mod tests {
             // The nearest is always found, and every kept candidate's cost is its own.
             assert_eq!(b[0], c[0], "query {q}");
             found += c.iter().filter(|t| b.contains(t)).count();
-            for s in 0..16 {
-                let t = c[s] as usize;
+            for (&t, &cost) in c.iter().zip(&clustered.costs[q * 16..][..16]) {
+                let t = t as usize;
                 let exact: f64 = (0..40)
                     .map(|j| (base[(t, j)] - query[(q, j)]).powi(2))
                     .sum();
-                assert!((clustered.costs[q * 16 + s] - exact).abs() < 1e-9);
+                assert!((cost - exact).abs() < 1e-9);
             }
             assert!(
                 clustered.costs[q * 16..][..16]
