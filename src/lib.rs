@@ -36,3 +36,4 @@ pub mod output;
 pub mod pipeline;
 pub mod spectral;
 pub mod stable;
+mod vertex_sets;
