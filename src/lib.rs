@@ -19,8 +19,10 @@
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
 //! | output | [`output`] | region files, coloured meshes, summaries |
+//! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
+//! | per-shape task | [`shape_task`] | the per-shape stage as bytes in, cache entry bytes out (for distributed engines) |
 #![deny(missing_docs)]
 
 pub mod affinity;
@@ -30,10 +32,12 @@ pub mod evaluate;
 pub mod features;
 pub mod generate;
 pub mod graph;
+pub mod labels;
 pub mod maps;
 pub mod mesh;
 pub mod output;
 pub mod pipeline;
+pub mod shape_task;
 pub mod spectral;
 pub mod stable;
 mod vertex_sets;

@@ -38,6 +38,9 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
     for w in &report.warnings {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
+    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &args.pipeline.options()) {
+        eprintln!("warning: {}: {w}", args.mesh.display());
+    }
     let opts = args.pipeline.options();
     let data = match &args.cache {
         Some(dir) => {

@@ -202,7 +202,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         map_guided,
     };
     let t = Instant::now();
-    let regions = segment_pair(
+    let pair = segment_pair(
         PairShape {
             mesh: ma,
             spectrum: &da.spectrum,
@@ -217,8 +217,11 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         },
         &pair_options,
     )
-    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?
-    .regions;
+    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
+    for f in &pair.fallbacks {
+        eprintln!("warning: {} x {}: {f}", args.a.display(), args.b.display());
+    }
+    let regions = pair.regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
@@ -255,7 +258,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     .with_map_preset(pair_options.map_guided.as_ref().map(|_| PresetChoice {
         preset: chosen,
         discrepancy: choice.discrepancy,
-    }));
+    }))
+    .with_fallbacks(pair.fallbacks);
     let shapes = [
         ShapeRegions {
             name: &na,

@@ -28,15 +28,19 @@
 
 mod ground_truth;
 mod group_parts;
+mod label_agreement;
 mod part_coverage;
 mod part_purity;
 mod read_labels;
 
 pub use ground_truth::GroundTruth;
 pub use group_parts::{PartGroups, group_parts};
+pub use label_agreement::{
+    LabelAgreement, PartAgreement, face_label_agreement, label_agreement, vertex_label_agreement,
+};
 pub use part_coverage::part_coverage;
 pub use part_purity::part_purity;
-pub use read_labels::read_labels;
+pub use read_labels::{parse_labels, read_labels};
 
 use crate::mesh::TriMesh;
 use std::collections::BTreeMap;

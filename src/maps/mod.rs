@@ -9,6 +9,7 @@
 mod auction_assignment;
 mod eigenvalue_discrepancy;
 mod map_preset;
+mod nearest_rows;
 mod region_point_map;
 pub(crate) mod zoomout;
 

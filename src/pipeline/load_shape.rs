@@ -80,11 +80,10 @@ pub fn load_or_compute(
         },
     };
     let data = compute_shape_data(mesh, options)?;
-    std::fs::create_dir_all(cache_dir).map_err(|source| PipelineError::Io {
-        path: cache_dir.display().to_string(),
-        source,
-    })?;
-    let write_error = write_entry(&path, &encode_shape_entry(&data))
+    // A cache that cannot be written (read-only, full, not a folder) costs a recomputation
+    // next time, not this run: the data are returned with a warning.
+    let write_error = std::fs::create_dir_all(cache_dir)
+        .and_then(|()| write_entry(&path, &encode_shape_entry(&data)))
         .err()
         .map(|e| format!("{}: cache entry not written: {e}", path.display()));
     Ok(CacheResult {
@@ -247,6 +246,9 @@ pub fn load_shape<T: ShapeContent>(
         .iter()
         .map(|w| format!("{}: {w}", path.display()))
         .collect();
+    if let Some(w) = super::small_mesh_warning(&mesh, options) {
+        warnings.push(format!("{}: {w}", path.display()));
+    }
     let t = Instant::now();
     let (data, outcome, more) = T::obtain(&mesh, options, cache_dir)?;
     warnings.extend(more);

@@ -25,5 +25,6 @@ pub use load_shape::{
 };
 pub use shape_data::{
     PipelineError, ShapeBands, ShapeData, ShapePipelineOptions, compute_shape_data,
-    encode_bands_entry, encode_shape_entry, shape_data_from_spectrum, shape_key,
+    decode_bands_entry, decode_shape_entry, encode_bands_entry, encode_shape_entry,
+    shape_data_from_spectrum, shape_key, small_mesh_warning,
 };

@@ -2,10 +2,12 @@
 //! it is computed from a mesh.
 
 use crate::bands::{BandError, BandOptions, BandTable, band_table};
-use crate::cache::{EntryKind, ShapeKey, encode_entry, entry_key};
+use crate::cache::{EntryKind, ShapeKey, decode_entry, encode_entry, entry_key};
 use crate::features::{DescriptorOptions, Descriptors, FeatureError, descriptors};
 use crate::mesh::{MeshError, TriMesh};
-use crate::spectral::{SpectralError, Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
+use crate::spectral::{
+    SpectralError, Spectrum, SpectrumOptions, available_eigenpairs, laplace_beltrami_spectrum,
+};
 use thiserror::Error;
 
 /// Errors of the per-shape pipeline and its cache.
@@ -96,6 +98,9 @@ impl ShapeBands {
         if !consistent {
             return Err("payload sizes do not match the mesh".into());
         }
+        if !self.vertex_areas.iter().all(|a| a.is_finite()) {
+            return Err("payload holds non-finite vertex areas".into());
+        }
         Ok(())
     }
 }
@@ -115,9 +120,27 @@ impl ShapeData {
             && self.descriptors.values.len() == n * vertices
             && self.bands.vertices == vertices
             && self.bands.features == n
-            && self.bands.labels.len() == n * vertices;
+            && self.bands.labels.len() == n * vertices
+            && self.spectrum.vertex_areas.len() == vertices
+            && self.descriptors.vertex_areas.len() == vertices
+            && self
+                .bands
+                .labels
+                .iter()
+                .all(|&l| (l as usize) < self.bands.bands);
         if !consistent {
             return Err("payload sizes do not match the mesh".into());
+        }
+        // A checksum only proves the bytes are the ones written; NaN must never come out of
+        // the cache into a stage (or an output file), whoever wrote the entry.
+        let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+        if !(finite(&self.spectrum.eigenvalues)
+            && finite(&self.spectrum.eigenvectors)
+            && finite(&self.spectrum.vertex_areas)
+            && finite(&self.descriptors.values)
+            && finite(&self.descriptors.vertex_areas))
+        {
+            return Err("payload holds non-finite numbers".into());
         }
         Ok(())
     }
@@ -162,8 +185,80 @@ pub fn compute_shape_data(
     mesh: &TriMesh,
     options: &ShapePipelineOptions,
 ) -> Result<ShapeData, PipelineError> {
-    let spectrum = laplace_beltrami_spectrum(mesh, &options.spectrum)?;
+    let mut spectrum_options = options.spectrum.clone();
+    spectrum_options.eigenpairs = spectrum_options.eigenpairs.min(available_eigenpairs(mesh));
+    let spectrum = laplace_beltrami_spectrum(mesh, &spectrum_options)?;
     shape_data_from_spectrum(mesh, spectrum, options)
+}
+
+/// The warning for a mesh with fewer usable vertices than the eigenpairs `options` ask for
+/// (see [`crate::spectral::available_eigenpairs`]): [`compute_shape_data`] then computes as
+/// many eigenpairs as the mesh has, and every later stage works with that many (the map step
+/// fits a smaller first map). `None` when the mesh is large enough.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, pipeline::{small_mesh_warning, ShapePipelineOptions}};
+/// let m = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
+/// let w = small_mesh_warning(&m, &ShapePipelineOptions::default()).unwrap();
+/// assert!(w.contains("3 of the 200 eigenpairs"), "{w}");
+/// ```
+pub fn small_mesh_warning(mesh: &TriMesh, options: &ShapePipelineOptions) -> Option<String> {
+    let available = available_eigenpairs(mesh);
+    let asked = options.spectrum.eigenpairs;
+    (available < asked).then(|| {
+        format!(
+            "{available} vertices carry area: computing {available} of the {asked} eigenpairs asked for"
+        )
+    })
+}
+
+/// Verifies and decodes the bytes of a full cache entry written for `key` on a mesh of
+/// `vertices` vertices; `Err` says why it cannot be trusted (frame, decoding, sizes,
+/// non-finite numbers: see [`crate::cache::read_entry`]). Never panics, whatever the bytes.
+///
+/// ```
+/// use coseg::mesh::TriMesh;
+/// use coseg::pipeline::{compute_shape_data, decode_shape_entry, encode_shape_entry, ShapePipelineOptions};
+/// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
+/// let mut o = ShapePipelineOptions::default();
+/// o.spectrum.eigenpairs = 4;
+/// o.bands.bands = 2;
+/// let data = compute_shape_data(&m, &o).unwrap();
+/// let mut bytes = encode_shape_entry(&data);
+/// assert_eq!(decode_shape_entry(&bytes, &data.key, 4).unwrap(), data);
+/// *bytes.last_mut().unwrap() ^= 1; // one flipped bit: the checksum no longer matches
+/// assert!(decode_shape_entry(&bytes, &data.key, 4).unwrap_err().contains("checksum"));
+/// ```
+pub fn decode_shape_entry(
+    bytes: &[u8],
+    key: &ShapeKey,
+    vertices: usize,
+) -> Result<ShapeData, String> {
+    decode_entry(bytes, EntryKind::Full, key, |d: &ShapeData| {
+        d.check(key, vertices)
+    })
+}
+
+/// [`decode_shape_entry`] for a compact bands entry.
+///
+/// ```
+/// use coseg::bands::equal_count_bands;
+/// use coseg::cache::ShapeKey;
+/// use coseg::pipeline::{decode_bands_entry, encode_bands_entry, ShapeBands};
+/// let bands = equal_count_bands(&[0.0, 1.0, 2.0], 1, 3, 2).unwrap();
+/// let data = ShapeBands { key: ShapeKey([7; 32]), bands, vertex_areas: vec![1.0 / 3.0; 3] };
+/// let bytes = encode_bands_entry(&data);
+/// assert_eq!(decode_bands_entry(&bytes, &data.key, 3).unwrap(), data);
+/// assert!(decode_bands_entry(&bytes[..bytes.len() - 1], &data.key, 3).is_err());
+/// ```
+pub fn decode_bands_entry(
+    bytes: &[u8],
+    key: &ShapeKey,
+    vertices: usize,
+) -> Result<ShapeBands, String> {
+    decode_entry(bytes, EntryKind::Bands, key, |d: &ShapeBands| {
+        d.check(key, vertices)
+    })
 }
 
 /// Descriptors and band table from an already computed spectrum (e.g. read elsewhere), keyed

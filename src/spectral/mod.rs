@@ -15,8 +15,8 @@ mod shift_invert;
 pub use cotan_laplacian::cotan_laplacian;
 pub use heat_smoother::HeatSmoother;
 pub use laplace_beltrami_spectrum::{
-    SpectrumOptions, SpectrumStats, dense_spectrum, laplace_beltrami_spectrum,
-    laplace_beltrami_spectrum_with_stats,
+    SpectrumOptions, SpectrumStats, available_eigenpairs, dense_spectrum,
+    laplace_beltrami_spectrum, laplace_beltrami_spectrum_with_stats,
 };
 pub use lumped_mass::lumped_mass;
 

@@ -35,7 +35,9 @@ pub use refine_partition::{
     RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
 };
 pub use refine_regions::refine_regions;
-pub use segment_pair::{PairShape, PairTimes, SegmentPairOptions, SegmentedPair, segment_pair};
+pub use segment_pair::{
+    PairShape, PairStage, PairTimes, SegmentPairOptions, SegmentedPair, StageFallback, segment_pair,
+};
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
 };
