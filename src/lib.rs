@@ -42,3 +42,4 @@ pub mod render;
 pub mod shape_task;
 pub mod spectral;
 pub mod stable;
+mod vertex_sets;

@@ -54,13 +54,13 @@
 //! tree is deterministic.
 
 use super::cosegment::{
-    Engine, area, confidence, remove_sorted, sample_triangles, seed_region, spanning_tree,
-    tuple_hash,
+    Engine, area, confidence, sample_triangles, seed_region, spanning_tree, tuple_hash,
 };
 use super::shape_graph::ShapeGraph;
 use super::{Cosegmentation, GraphError, RegionTuple};
 use crate::affinity::{BandAffinity, Direction};
 use crate::stable::{Threshold, ThresholdScratch, threshold};
+use crate::vertex_sets::remove_sorted;
 use serde::{Deserialize, Serialize};
 
 /// Options of [`adaptive_cosegment`].

@@ -49,10 +49,11 @@
 //! deterministic sample of the graph's triangles.
 
 use super::shape_graph::ShapeGraph;
-use super::stable_cycle::{CycleShape, CycleStep, intersect_sorted};
+use super::stable_cycle::{CycleShape, CycleStep};
 use super::{GraphError, cycle_consistency};
 use crate::affinity::BandAffinity;
 use crate::stable::{Threshold, threshold};
+use crate::vertex_sets::{intersect_sorted, remove_sorted};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 use rayon::prelude::*;
@@ -647,16 +648,6 @@ pub(super) fn seed_region(
             out
         }
     }
-}
-
-pub(super) fn remove_sorted(from: &mut Vec<u32>, remove: &[u32]) {
-    let mut j = 0;
-    from.retain(|&v| {
-        while j < remove.len() && remove[j] < v {
-            j += 1;
-        }
-        !(j < remove.len() && remove[j] == v)
-    });
 }
 
 pub(super) fn area(areas: &[f64], v: &[u32]) -> f64 {

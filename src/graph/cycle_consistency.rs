@@ -1,9 +1,10 @@
 //! [`cycle_consistency`]: how much of a region carried once around a cycle comes back.
 
 use super::GraphError;
-use super::stable_cycle::{CycleShape, CycleStep, intersect_sorted};
+use super::stable_cycle::{CycleShape, CycleStep};
 use crate::affinity::AffinityWorkspace;
 use crate::stable::threshold;
+use crate::vertex_sets::intersect_sorted;
 use serde::{Deserialize, Serialize};
 
 /// The region carried once around a cycle and its agreement with where it started.

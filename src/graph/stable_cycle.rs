@@ -4,6 +4,7 @@
 use super::GraphError;
 use crate::affinity::{AffinityWorkspace, BandAffinity, Direction};
 use crate::stable::{Threshold, threshold};
+use crate::vertex_sets::{intersect_sorted, selected_sum};
 use serde::{Deserialize, Serialize};
 
 /// One shape of a cycle: its remaining vertices, areas and the thresholding rule applied to the
@@ -64,36 +65,6 @@ impl Default for StableCycleOptions {
             max_iterations: 100,
         }
     }
-}
-
-/// Sorted intersection of two ascending lists.
-pub(crate) fn intersect_sorted(a: &[u32], b: &[u32], out: &mut Vec<u32>) {
-    out.clear();
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        match a[i].cmp(&b[j]) {
-            std::cmp::Ordering::Less => i += 1,
-            std::cmp::Ordering::Greater => j += 1,
-            std::cmp::Ordering::Equal => {
-                out.push(a[i]);
-                i += 1;
-                j += 1;
-            }
-        }
-    }
-}
-
-/// Sum of `scores[i]` over the positions whose vertex is selected (both lists ascending).
-pub(crate) fn selected_sum(vertices: &[u32], scores: &[f64], selected: &[u32]) -> f64 {
-    let mut s = 0.0;
-    let mut j = 0;
-    for (&v, &sc) in vertices.iter().zip(scores) {
-        if j < selected.len() && selected[j] == v {
-            s += sc;
-            j += 1;
-        }
-    }
-    s
 }
 
 fn ascending(v: &[u32]) -> bool {

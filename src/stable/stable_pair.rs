@@ -2,6 +2,7 @@
 
 use super::{StableError, Threshold, ThresholdScratch, threshold};
 use crate::affinity::{AffinityWorkspace, BandAffinity, Direction, IndicatorHistogram};
+use crate::vertex_sets::{intersect_sorted, selected_sum};
 use serde::{Deserialize, Serialize};
 
 /// The remaining vertex subsets of both shapes and the per-vertex areas the rules use.
@@ -75,36 +76,6 @@ pub struct StableWorkspace {
     scratch: ThresholdScratch,
     /// Incremental histograms of `f` (A → B) and `g` (B → A).
     hists: Option<(IndicatorHistogram, IndicatorHistogram)>,
-}
-
-/// Sorted intersection of two ascending lists.
-pub(crate) fn intersect_sorted(a: &[u32], b: &[u32], out: &mut Vec<u32>) {
-    out.clear();
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() && j < b.len() {
-        match a[i].cmp(&b[j]) {
-            std::cmp::Ordering::Less => i += 1,
-            std::cmp::Ordering::Greater => j += 1,
-            std::cmp::Ordering::Equal => {
-                out.push(a[i]);
-                i += 1;
-                j += 1;
-            }
-        }
-    }
-}
-
-/// Sum of `scores[i]` over positions whose vertex is selected (both lists ascending).
-fn selected_sum(vertices: &[u32], scores: &[f64], selected: &[u32]) -> f64 {
-    let mut s = 0.0;
-    let mut j = 0;
-    for (&v, &sc) in vertices.iter().zip(scores) {
-        if j < selected.len() && selected[j] == v {
-            s += sc;
-            j += 1;
-        }
-    }
-    s
 }
 
 /// Algorithm 1 with a fresh workspace. See [`stable_pair_with`].

@@ -6,6 +6,7 @@ use super::{
     Remaining, StableError, StablePair, StablePairOptions, StableWorkspace, initial_indicator,
 };
 use crate::affinity::BandAffinity;
+use crate::vertex_sets::remove_sorted;
 
 /// Shared state of Algorithms 2 and 3: remaining vertices and areas.
 pub(crate) struct Extraction<'s> {
@@ -131,17 +132,6 @@ impl<'s> Extraction<'s> {
             auto: None,
         })
     }
-}
-
-/// Removes the ascending `remove` from the ascending `from`.
-pub(crate) fn remove_sorted(from: &mut Vec<u32>, remove: &[u32]) {
-    let mut j = 0;
-    from.retain(|v| {
-        while j < remove.len() && remove[j] < *v {
-            j += 1;
-        }
-        !(j < remove.len() && remove[j] == *v)
-    });
 }
 
 /// Algorithm 2: `K − 1` stable pairs with the fixed rules `options.p` (on B) and `options.q`
