@@ -18,6 +18,7 @@
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
 //! | output | [`output`] | region files, coloured meshes, summaries |
 //! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
+//! | propagation | [`propagate`] | part labels carried from annotated shapes to a collection |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
 #![deny(missing_docs)]
@@ -32,5 +33,6 @@ pub mod graph;
 pub mod labels;
 pub mod mesh;
 pub mod output;
+pub mod propagate;
 pub mod spectral;
 pub mod stable;

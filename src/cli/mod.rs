@@ -6,6 +6,7 @@ mod generate;
 mod info;
 mod pair;
 mod pipeline_args;
+mod propagate;
 mod segment;
 mod spectrum;
 
@@ -41,6 +42,8 @@ enum Command {
     Pair(pair::PairArgs),
     /// Co-segment every mesh of a folder into corresponding regions (same id = same part).
     Segment(segment::SegmentArgs),
+    /// Carry part labels from a few annotated meshes to every mesh of a folder.
+    Propagate(propagate::PropagateArgs),
 }
 
 /// Runs a parsed command line; the exit code tells success, partial success or failure.
@@ -53,6 +56,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Generate(args) => generate::run(args),
         Command::Pair(args) => pair::run(args),
         Command::Segment(args) => segment::run(args),
+        Command::Propagate(args) => propagate::run(args),
     }
 }
 
