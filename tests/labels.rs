@@ -234,7 +234,9 @@ fn part_names_and_writers() {
     assert_eq!(n.len(), 2);
     assert_eq!(n[&2], "seat");
     std::fs::write(d.join("bad.json"), r#"{"leg": "x"}"#).unwrap();
-    let e = read_part_names(&d.join("bad.json")).unwrap_err().to_string();
+    let e = read_part_names(&d.join("bad.json"))
+        .unwrap_err()
+        .to_string();
     assert!(e.contains("bad.json") && e.contains("leg"), "{e}");
     std::fs::write(d.join("bad2.json"), "[1, 2]").unwrap();
     assert!(read_part_names(&d.join("bad2.json")).is_err());

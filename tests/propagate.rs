@@ -113,9 +113,9 @@ fn partial_annotations_keep_their_labels_and_fill_the_rest() {
         &PropagateOptions::default(),
     )
     .unwrap();
-    for v in 0..d {
-        if partial[v] >= 0 {
-            assert_eq!(p.labels[0][v], partial[v]);
+    for (v, &l) in partial.iter().enumerate() {
+        if l >= 0 {
+            assert_eq!(p.labels[0][v], l);
             assert_eq!(p.confidence[0][v], 1.0);
         }
         assert!(p.labels[0][v] >= 0);

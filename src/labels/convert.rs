@@ -52,8 +52,8 @@ pub fn faces_to_vertices(mesh: &TriMesh, face_labels: &[i32]) -> Result<Vec<i32>
                 best = match best {
                     None => Some(e),
                     Some(b) => {
-                        let better = e.1 > b.1
-                            || (e.1 == b.1 && (e.2 > b.2 || (e.2 == b.2 && e.0 < b.0)));
+                        let better =
+                            e.1 > b.1 || (e.1 == b.1 && (e.2 > b.2 || (e.2 == b.2 && e.0 < b.0)));
                         Some(if better { e } else { b })
                     }
                 };

@@ -6,6 +6,9 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// Label files matched to meshes, `(mesh index, file)` by mesh index, and warnings.
+pub type MatchedLabels = (Vec<(usize, PathBuf)>, Vec<String>);
+
 /// Part names: `label → name`, carried into outputs.
 pub type PartNames = BTreeMap<i32, String>;
 
@@ -121,7 +124,10 @@ pub fn read_shape_labels(
         LabelKind::Vertex => file_labels.clone(),
         LabelKind::Face => faces_to_vertices(mesh, &file_labels)?,
     };
-    vertex_labels.iter_mut().filter(|l| **l < 0).for_each(|l| *l = -1);
+    vertex_labels
+        .iter_mut()
+        .filter(|l| **l < 0)
+        .for_each(|l| *l = -1);
     Ok(ShapeLabels {
         path: path.to_path_buf(),
         kind,
@@ -146,7 +152,9 @@ pub fn label_file_stem(path: &Path) -> Option<String> {
             return Some(name[..name.len() - suffix.len()].to_string());
         }
     }
-    path.file_stem().and_then(|s| s.to_str()).map(str::to_string)
+    path.file_stem()
+        .and_then(|s| s.to_str())
+        .map(str::to_string)
 }
 
 fn is_label_file(path: &Path) -> bool {
@@ -178,7 +186,7 @@ fn is_label_file(path: &Path) -> bool {
 pub fn match_label_files(
     inputs: &[PathBuf],
     stems: &[String],
-) -> Result<(Vec<(usize, PathBuf)>, Vec<String>), LabelError> {
+) -> Result<MatchedLabels, LabelError> {
     let index: BTreeMap<&str, usize> = stems
         .iter()
         .enumerate()

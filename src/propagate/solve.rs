@@ -335,9 +335,9 @@ impl Propagation {
         let n = graph.node_count();
         let mut dist = vec![f64::INFINITY; n];
         let mut done = vec![false; n];
-        for i in 0..n {
-            if self.sources[i] {
-                dist[i] = 0.0;
+        for (d, &s) in dist.iter_mut().zip(&self.sources) {
+            if s {
+                *d = 0.0;
             }
         }
         let mut order = Vec::with_capacity(n);
