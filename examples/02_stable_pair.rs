@@ -13,14 +13,14 @@
 //! (left/right legs merged: an intrinsic method cannot tell mirror images apart).
 
 use coseg::affinity::BandAffinity;
-use coseg::cache::{ShapePipelineOptions, compute_shape_data};
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
+use coseg::maps::{ShapeGeometry, map_preset};
 use coseg::mesh::read_mesh;
+use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
 use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    PairShape, RefineOptions, SegmentPairOptions, ShapeGeometry, StableRegions,
-    StableRegionsOptions, map_guided_refinement, map_preset, refine_regions, segment_pair,
-    stable_regions,
+    PairShape, RefineOptions, SegmentPairOptions, StableRegions, StableRegionsOptions,
+    map_guided_refinement, refine_regions, segment_pair, stable_regions,
 };
 use std::path::Path;
 

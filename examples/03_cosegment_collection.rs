@@ -10,11 +10,11 @@
 //! `refine_cosegmentation`, exactly as `coseg segment` does. Purity: how much of each region lies in one
 //! ground-truth part. Coverage: how much of each part one region covers, on all shapes at once.
 
-use coseg::cache::ShapePipelineOptions;
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
 use coseg::graph::{
     Cosegmentation, LoadedCollection, SegmentCollectionOptions, load_collection, segment_collection,
 };
+use coseg::pipeline::ShapePipelineOptions;
 use std::path::PathBuf;
 
 fn score(

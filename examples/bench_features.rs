@@ -10,9 +10,11 @@
 //! ```
 
 use coseg::bands::{BandOptions, band_table};
-use coseg::cache::{ShapePipelineOptions, encode_entry, shape_data_from_spectrum};
 use coseg::features::{DescriptorOptions, descriptors};
 use coseg::mesh::read_mesh;
+use coseg::pipeline::{
+    ShapePipelineOptions, encode_shape_entry as encode_entry, shape_data_from_spectrum,
+};
 use coseg::spectral::Spectrum;
 use std::time::Instant;
 
@@ -109,7 +111,7 @@ fn main() -> anyhow::Result<()> {
     let data = shape_data_from_spectrum(&mesh, spectrum, &ShapePipelineOptions::default())?;
     let bytes = encode_entry(&data);
     let t0 = Instant::now();
-    let (decoded, _): (coseg::cache::ShapeData, usize) =
+    let (decoded, _): (coseg::pipeline::ShapeData, usize) =
         bincode::serde::decode_from_slice(&bytes[84..], bincode::config::standard())?;
     let dt = t0.elapsed().as_secs_f64();
     std::hint::black_box(decoded);

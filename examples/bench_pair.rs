@@ -5,7 +5,7 @@
 //!     [--synthetic] [--repeats R]
 //! ```
 //! With `--cache DIR`, the per-shape data (spectrum, 100 HKS + 100 WKS + 100 mean curvature,
-//! K = 20 bands) come from `coseg::cache::load_or_compute` (computed once, excluded from the
+//! K = 20 bands) come from `coseg::pipeline::load_or_compute` (computed once, excluded from the
 //! timings). With `--synthetic`, band tables are made from N smooth pseudo-features of the vertex
 //! positions (random projections and their sines) instead, for when the spectrum is unavailable.
 //! Prints: one `W·x` (indicator and general f64), the time to stream the same bytes, Algorithm 2
@@ -93,10 +93,10 @@ fn main() -> anyhow::Result<()> {
         )
     } else {
         let dir = std::path::PathBuf::from(cache.clone().unwrap());
-        let mut o = coseg::cache::ShapePipelineOptions::default();
+        let mut o = coseg::pipeline::ShapePipelineOptions::default();
         o.bands.bands = bands;
-        let a = coseg::cache::load_or_compute(&ma, &o, &dir)?;
-        let b = coseg::cache::load_or_compute(&mb, &o, &dir)?;
+        let a = coseg::pipeline::load_or_compute(&ma, &o, &dir)?;
+        let b = coseg::pipeline::load_or_compute(&mb, &o, &dir)?;
         (a.data.bands, b.data.bands)
     };
     println!(

@@ -10,12 +10,13 @@
 //! smoothers, refinement). Warm: the same from the cache's compact bands entries (as
 //! `load_collection` reads them). Mesh reading is reported apart.
 
-use coseg::cache::{
-    CacheOutcome, ShapeBands, ShapePipelineOptions, bands_path, cache_path, encode_bands_entry,
-    encode_entry, load_or_compute_bands, shape_data_from_spectrum, shape_key,
-};
+use coseg::cache::{CacheOutcome, bands_path, cache_path};
 use coseg::graph::{SegmentCollectionOptions, SegmentTimes, ShapeNode, segment_collection};
 use coseg::mesh::read_mesh;
+use coseg::pipeline::{
+    ShapeBands, ShapePipelineOptions, encode_bands_entry, encode_shape_entry as encode_entry,
+    load_or_compute_bands, shape_data_from_spectrum, shape_key,
+};
 use coseg::spectral::laplace_beltrami_spectrum;
 use rayon::prelude::*;
 use std::path::PathBuf;

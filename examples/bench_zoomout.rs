@@ -4,14 +4,14 @@
 //! ```text
 //! cargo run --release --example bench_zoomout -- A.off B.off [--cache DIR] [--repeats R]
 //! ```
-//! Per-shape data come from `coseg::cache::load_or_compute` (computed once, excluded). ZoomOut
+//! Per-shape data come from `coseg::pipeline::load_or_compute` (computed once, excluded). ZoomOut
 //! starts from the identity map (shapes of one TOSCA class share their vertex order) with the
 //! default sizes (10 → 150, 2,000 samples); every configuration is run `R` times (default 3)
 //! and its wall times printed, with the share of vertices mapped to themselves.
 
-use coseg::cache::{ShapePipelineOptions, load_or_compute};
+use coseg::maps::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
 use coseg::mesh::read_mesh;
-use coseg::spectral::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
+use coseg::pipeline::{ShapePipelineOptions, load_or_compute};
 use std::path::PathBuf;
 use std::time::Instant;
 

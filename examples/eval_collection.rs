@@ -11,12 +11,12 @@
 //! shapes give a vertex the same region id.
 
 use coseg::affinity::BandAffinity;
-use coseg::cache::{ShapePipelineOptions, load_or_compute};
 use coseg::graph::{
     CosegmentOptions, GraphOptions, SegmentCollectionOptions, ShapeGraph, ShapeNode, cosegment,
     refine_cosegmentation,
 };
 use coseg::mesh::read_mesh;
+use coseg::pipeline::{ShapePipelineOptions, load_or_compute};
 use coseg::spectral::HeatSmoother;
 use coseg::stable::RefineOptions;
 use coseg::stable::{StableRegionsOptions, Threshold, refine_regions, stable_regions};

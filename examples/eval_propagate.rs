@@ -12,11 +12,11 @@
 //! Accuracy is area-weighted: per face against `.seg` files for the chairs, per vertex for
 //! the identity sets; the source shapes are left out of every mean.
 
-use coseg::cache::{ShapePipelineOptions, load_or_compute_bands};
 use coseg::evaluate::{face_label_agreement, vertex_label_agreement};
 use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
 use coseg::labels::{faces_to_vertices, read_label_file};
 use coseg::mesh::{TriMesh, read_mesh};
+use coseg::pipeline::{ShapePipelineOptions, load_or_compute_bands};
 use coseg::propagate::{PropagateOptions, propagate_labels};
 use coseg::spectral::HeatSmoother;
 use rand::SeedableRng;

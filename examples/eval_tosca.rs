@@ -19,14 +19,16 @@
 
 use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
-use coseg::cache::{ShapeData, ShapePipelineOptions, load_or_compute};
+use coseg::maps::MapGuidedOptions;
+use coseg::maps::{FinalMatch, ZoomOutOptions, zoomout};
+use coseg::maps::{MapPreset, ShapeGeometry, map_preset};
 use coseg::mesh::{TriMesh, read_mesh};
-use coseg::spectral::{FinalMatch, HeatSmoother, ZoomOutOptions, zoomout};
+use coseg::pipeline::{ShapeData, ShapePipelineOptions, load_or_compute};
+use coseg::spectral::HeatSmoother;
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, PairShape, RefineOptions,
-    SegmentPairOptions, ShapeGeometry, StableRegionsOptions, TSearch, VertexMap,
-    correspondence_stats, map_preset, point_map_refinement, refine_regions, segment_pair,
-    stable_regions,
+    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
+    StableRegionsOptions, TSearch, VertexMap, correspondence_stats, point_map_refinement,
+    refine_regions, segment_pair, stable_regions,
 };
 use std::path::PathBuf;
 use std::time::Instant;

@@ -13,6 +13,8 @@
 //! | spectrum | [`spectral`] | cotangent Laplacian, lumped mass, Laplace–Beltrami eigenpairs |
 //! | features | [`features`] | HKS, WKS and multiscale mean curvature per vertex |
 //! | bands | [`bands`] | per-feature rank bands stored as a compact `u8` table |
+//! | per-shape pipeline | [`pipeline`] | mesh → spectrum → features → bands once per shape, through [`cache`] (storage only); [`pipeline::load_shape`] is the one loader |
+//! | correspondence maps | [`maps`] | functional maps, ZoomOut, one-to-one matches, map presets |
 //! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
@@ -21,6 +23,7 @@
 //! | propagation | [`propagate`] | part labels carried from annotated shapes to a collection |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
+//! | per-shape task | [`shape_task`] | the per-shape stage as bytes in, cache entry bytes out (for distributed engines) |
 #![deny(missing_docs)]
 
 pub mod affinity;
@@ -31,8 +34,11 @@ pub mod features;
 pub mod generate;
 pub mod graph;
 pub mod labels;
+pub mod maps;
 pub mod mesh;
 pub mod output;
+pub mod pipeline;
 pub mod propagate;
+pub mod shape_task;
 pub mod spectral;
 pub mod stable;

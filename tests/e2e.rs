@@ -315,7 +315,7 @@ fn segment_reports_a_malformed_mesh_and_segments_the_rest() {
 
 #[test]
 fn pair_map_preset_follows_the_spectra() {
-    use coseg::stable::NEAR_ISOMETRIC_DISCREPANCY;
+    use coseg::maps::NEAR_ISOMETRIC_DISCREPANCY;
     let run = pair_run();
     assert_success(run);
     // Two different generated bodies: the general preset.

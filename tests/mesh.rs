@@ -529,7 +529,6 @@ const CORPUS: &[(&str, Kind, &str)] = &[
     ("bad_counts.off", Kind::Header, "invalid vertex count"),
     ("binary.off", Kind::Header, "unsupported encoding"),
     ("four_d.off", Kind::Header, "unsupported OFF variant"),
-    ("extra_data.off", Kind::Parse, "line 7: unexpected data"),
     (
         "short_face.off",
         Kind::Parse,
@@ -593,6 +592,23 @@ fn malformed_corpus_gives_the_expected_error_naming_the_file() {
         );
         assert!(msg.contains(fragment), "{name}: `{fragment}` not in: {msg}");
     }
+}
+
+/// Regression (#18): an OFF file with a record after the faces its header declares was an
+/// error where other readers warn; the declared mesh is read, with a warning naming the line.
+#[test]
+fn off_with_data_after_the_declared_elements_is_read_with_a_warning() {
+    let path = corpus_dir().parent().unwrap().join("extra_data.off");
+    let (mesh, report) = read_mesh_with_report(&path).unwrap();
+    assert_eq!((mesh.vertex_count(), mesh.face_count()), (3, 1));
+    let ignored: Vec<String> = report
+        .warnings
+        .iter()
+        .filter(|w| matches!(w, coseg::mesh::MeshWarning::IgnoredData { .. }))
+        .map(|w| w.to_string())
+        .collect();
+    assert_eq!(ignored.len(), 1, "{:?}", report.warnings);
+    assert!(ignored[0].contains("line 7"), "{}", ignored[0]);
 }
 
 #[test]

@@ -440,11 +440,9 @@ fn heat_smoother_keeps_constants_and_integrals() {
 
 mod zoomout_map {
     use super::common::features::{blob, permutation, permute_mesh};
+    use coseg::maps::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
     use coseg::mesh::TriMesh;
-    use coseg::spectral::{
-        FinalMatch, ShapeGeometry, Spectrum, SpectrumOptions, ZoomOutOptions,
-        laplace_beltrami_spectrum, zoomout,
-    };
+    use coseg::spectral::{Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
 
     fn options() -> ZoomOutOptions {
         ZoomOutOptions {
@@ -598,10 +596,8 @@ mod zoomout_map {
 
 mod zoomout_descriptors {
     use super::common::features::{blob, permutation, permute_mesh};
-    use coseg::spectral::{
-        FinalMatch, ShapeGeometry, SpectrumOptions, ZoomOutOptions, laplace_beltrami_spectrum,
-        zoomout,
-    };
+    use coseg::maps::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
+    use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 
     /// Coordinates as three feature-major descriptor columns: on a vertex-permuted copy they
     /// identify every vertex exactly.
@@ -667,7 +663,7 @@ mod zoomout_descriptors {
 }
 
 mod auction {
-    use coseg::spectral::{AuctionOptions, CandidateLists, auction_assignment};
+    use coseg::maps::{AuctionOptions, CandidateLists, auction_assignment};
     use proptest::prelude::*;
     use proptest::test_runner::{Config, RngSeed};
 
@@ -859,7 +855,8 @@ mod auction {
 
 mod discrepancy {
     use super::common::features::{blob, permutation, permute_mesh};
-    use coseg::spectral::{SpectrumOptions, eigenvalue_discrepancy, laplace_beltrami_spectrum};
+    use coseg::maps::eigenvalue_discrepancy;
+    use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 
     #[test]
     fn eigenvalue_discrepancy_is_zero_for_isometric_copies_and_grows_with_stretch() {

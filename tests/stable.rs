@@ -795,15 +795,16 @@ fn refine_regions_rebuilds_pairs_with_dense_objectives() {
 mod map_guided {
     use super::common::features::{blob, permutation, permute_mesh};
     use coseg::affinity::{BandAffinity, Direction};
-    use coseg::cache::{ShapeData, ShapePipelineOptions, compute_shape_data};
+    use coseg::maps::MapGuidedOptions;
+    use coseg::maps::ZoomOutOptions;
+    use coseg::maps::{MapShape, PointMapOptions, ShapeGeometry, region_point_map};
     use coseg::mesh::TriMesh;
+    use coseg::pipeline::{ShapeData, ShapePipelineOptions, compute_shape_data};
     use coseg::spectral::HeatSmoother;
-    use coseg::spectral::ZoomOutOptions;
     use coseg::stable::{
-        MapGuidedOptions, MapShape, PairShape, PointMapOptions, RefineOptions, RegionPair,
-        SegmentPairOptions, ShapeGeometry, StableRegions, StableRegionsOptions, Threshold,
-        assign_regions, map_guided_refinement, point_map_refinement, refine_regions,
-        region_point_map, region_scores, segment_pair, stable_regions,
+        PairShape, RefineOptions, RegionPair, SegmentPairOptions, StableRegions,
+        StableRegionsOptions, Threshold, assign_regions, map_guided_refinement,
+        point_map_refinement, refine_regions, region_scores, segment_pair, stable_regions,
     };
 
     fn small_pipeline() -> ShapePipelineOptions {
@@ -1135,8 +1136,9 @@ mod map_guided {
 
 mod preset {
     use super::common::features::{blob, permutation, permute_mesh};
+    use coseg::maps::MapGuidedOptions;
+    use coseg::maps::{MapPreset, NEAR_ISOMETRIC_DISCREPANCY, map_preset};
     use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
-    use coseg::stable::{MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY, map_preset};
 
     #[test]
     fn map_preset_tells_a_repose_from_a_different_body() {

@@ -1,8 +1,9 @@
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
+use coseg::cache::CacheOutcome;
 use coseg::features::{ExportFormat, ExportOptions, export_features};
 use coseg::mesh::read_mesh_with_report;
+use coseg::pipeline::{compute_shape_data, load_or_compute};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -35,6 +36,9 @@ pub struct FeaturesArgs {
 pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
     let (mesh, report) = read_mesh_with_report(&args.mesh)?;
     for w in &report.warnings {
+        eprintln!("warning: {}: {w}", args.mesh.display());
+    }
+    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &args.pipeline.options()) {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
     let opts = args.pipeline.options();

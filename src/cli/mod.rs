@@ -60,6 +60,25 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
     }
 }
 
+/// The error and its causes on one line, `outer: inner: …`, each cause shown once: a library
+/// error whose message already includes its source (`path: No such file or directory`) is
+/// not followed by that source again.
+pub fn error_message(err: &anyhow::Error) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for cause in err.chain() {
+        let text = cause.to_string();
+        if parts.iter().any(|p| p.contains(&text)) {
+            continue;
+        }
+        // A context that only names the file the cause names too: keep the cause.
+        match parts.last_mut() {
+            Some(last) if text.starts_with(last.as_str()) => *last = text,
+            _ => parts.push(text),
+        }
+    }
+    parts.join(": ")
+}
+
 /// 0 when nothing failed, [`EXIT_FAILURE`] when everything failed, [`EXIT_PARTIAL`] otherwise.
 fn exit_code(failed: usize, total: usize) -> ExitCode {
     if failed == 0 {

@@ -2,15 +2,16 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::cache::{CacheOutcome, compute_shape_data, load_or_compute};
-use coseg::mesh::read_mesh_with_report;
+use coseg::maps::MapGuidedOptions;
+use coseg::maps::ZoomOutOptions;
+use coseg::maps::{
+    MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
+};
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions};
-use coseg::spectral::ZoomOutOptions;
+use coseg::pipeline::{PipelineError, ShapeData, load_shape};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY,
-    PairShape, PointMapOptions, PresetChoice, RefineOptions, SegmentPairOptions,
-    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, map_preset,
-    segment_pair,
+    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
+    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -102,7 +103,7 @@ pub struct PairArgs {
     /// descriptors in the point map's last match; TOSCA within-class 95.7 % against 94.3 %,
     /// but worse on different bodies), `general`, or `auto`, which picks `near-isometric`
     /// when the two spectra agree (eigenvalue discrepancy below 0.03, see
-    /// `coseg::stable::map_preset`).
+    /// `coseg::maps::map_preset`).
     #[arg(long, value_enum, default_value = "auto")]
     map_preset: MapPresetArg,
     /// Same as `--map-preset near-isometric`.
@@ -131,27 +132,15 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     let pipe = args.pipeline.options();
     let mut loaded = Vec::new();
     for path in [&args.a, &args.b] {
-        let (mesh, report) = read_mesh_with_report(path)?;
-        for w in &report.warnings {
-            eprintln!("warning: {}: {w}", path.display());
-        }
-        let data = match &args.cache {
-            Some(dir) => {
-                let r = load_or_compute(&mesh, &pipe, dir)
-                    .with_context(|| format!("{}", path.display()))?;
-                if let CacheOutcome::Recomputed { reason } = &r.outcome {
-                    eprintln!("warning: {reason}");
-                }
-                if let Some(e) = &r.write_error {
-                    eprintln!("warning: {e}");
-                }
-                r.data
-            }
-            None => {
-                compute_shape_data(&mesh, &pipe).with_context(|| format!("{}", path.display()))?
-            }
+        let shape = match load_shape::<ShapeData>(path, &pipe, args.cache.as_deref()) {
+            Ok(s) => s,
+            Err(PipelineError::Mesh(e)) => return Err(e.into()),
+            Err(e) => return Err(anyhow::Error::new(e).context(format!("{}", path.display()))),
         };
-        loaded.push((mesh, data));
+        for w in &shape.warnings {
+            eprintln!("warning: {w}");
+        }
+        loaded.push((shape.mesh, shape.data));
     }
     let options = StableRegionsOptions {
         algorithm: match args.algorithm {
@@ -213,7 +202,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         map_guided,
     };
     let t = Instant::now();
-    let regions = segment_pair(
+    let pair = segment_pair(
         PairShape {
             mesh: ma,
             spectrum: &da.spectrum,
@@ -228,8 +217,11 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         },
         &pair_options,
     )
-    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?
-    .regions;
+    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
+    for f in &pair.fallbacks {
+        eprintln!("warning: {} x {}: {f}", args.a.display(), args.b.display());
+    }
+    let regions = pair.regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
@@ -266,7 +258,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     .with_map_preset(pair_options.map_guided.as_ref().map(|_| PresetChoice {
         preset: chosen,
         discrepancy: choice.discrepancy,
-    }));
+    }))
+    .with_fallbacks(pair.fallbacks);
     let shapes = [
         ShapeRegions {
             name: &na,

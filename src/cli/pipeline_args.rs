@@ -2,7 +2,7 @@
 
 use clap::Args;
 use coseg::bands::BandWeighting;
-use coseg::cache::ShapePipelineOptions;
+use coseg::pipeline::ShapePipelineOptions;
 
 #[derive(Debug, Args)]
 pub struct PipelineArgs {

@@ -4,7 +4,8 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{
-    CosegmentOptions, GraphOptions, SegmentCollectionOptions, load_collection, segment_collection,
+    AdaptiveOptions, CosegmentOptions, GraphOptions, PartsReport, SegmentCollectionOptions,
+    load_collection, segment_collection,
 };
 use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions};
 use coseg::stable::RefineOptions;
@@ -25,9 +26,15 @@ pub struct SegmentArgs {
     /// Per-shape cache folder (default: `<OUT>/.cache`).
     #[arg(long)]
     cache: Option<PathBuf>,
-    /// Regions per shape, the last being the leftovers.
-    #[arg(long, default_value_t = CosegmentOptions::default().regions)]
-    regions: usize,
+    /// Regions per shape, the last being the leftovers (default 6); with `--parts`, the upper
+    /// bound on the number of parts (default 8).
+    #[arg(long)]
+    regions: Option<usize>,
+    /// Parts of their own size (Algorithm 3 across the collection, see docs/PARTS.md): `auto`
+    /// = as many as are stable and consistent, `N` = cut the tree of parts at N. Without it,
+    /// `--regions` equal-area regions.
+    #[arg(long, value_parser = parse_parts)]
+    parts: Option<PartsArg>,
     /// Area of each region as a fraction of its shape (default: 1 / regions).
     #[arg(long)]
     area_fraction: Option<f64>,
@@ -51,6 +58,23 @@ pub struct SegmentArgs {
     smoothing_time: f64,
     #[command(flatten)]
     pipeline: super::pipeline_args::PipelineArgs,
+}
+
+/// `--parts auto|N`.
+#[derive(Debug, Clone, Copy)]
+enum PartsArg {
+    Auto,
+    Count(usize),
+}
+
+fn parse_parts(s: &str) -> Result<PartsArg, String> {
+    match s {
+        "auto" => Ok(PartsArg::Auto),
+        _ => match s.parse::<usize>() {
+            Ok(k) if k >= 1 => Ok(PartsArg::Count(k)),
+            _ => Err(format!("{s:?}: expected `auto` or a number of parts ≥ 1")),
+        },
+    }
 }
 
 pub fn run(args: SegmentArgs) -> Result<ExitCode> {
@@ -106,7 +130,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             ..Default::default()
         },
         cosegment: CosegmentOptions {
-            regions: args.regions,
+            regions: args.regions.unwrap_or(CosegmentOptions::default().regions),
             area_fraction: args.area_fraction,
             seed: args.seed,
             ..Default::default()
@@ -114,6 +138,18 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         refine: (args.refine_rounds > 0).then_some(RefineOptions {
             max_rounds: args.refine_rounds,
             smoothing_time: args.smoothing_time,
+        }),
+        parts: args.parts.map(|p| {
+            let mut o = AdaptiveOptions::default();
+            if let PartsArg::Count(k) = p {
+                o.parts = Some(k);
+                o.max_parts = o.max_parts.max(k);
+            }
+            if let Some(r) = args.regions {
+                o.max_parts = r;
+            }
+            o.seed = args.seed;
+            o
         }),
     };
     let result = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?;
@@ -132,7 +168,18 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             error: s.error.clone(),
         })
         .collect();
-    let summary = CollectionSummary::new(&result, &files, &options, skipped);
+    let mut summary = CollectionSummary::new(&result, &files, &options, skipped);
+    if let Some(a) = &result.adaptive {
+        let report = PartsReport::new(a, seg, &loaded.meshes);
+        println!(
+            "parts: {} finest ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}",
+            a.leaves.tuples.len(),
+            a.stop,
+            seg.tuples.len(),
+            report.mirror_candidates
+        );
+        summary.parts = Some(report);
+    }
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
     let shapes: Vec<ShapeRegions> = seg
         .names

@@ -1,7 +1,9 @@
 use anyhow::{Context, Result};
 use clap::Args;
 use coseg::mesh::read_mesh;
-use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum_with_stats};
+use coseg::spectral::{
+    SpectrumOptions, available_eigenpairs, laplace_beltrami_spectrum_with_stats,
+};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -49,6 +51,17 @@ pub fn run(args: SpectrumArgs) -> Result<ExitCode> {
         threads: args.threads,
         basis_size: args.basis_size,
         ..SpectrumOptions::default()
+    };
+    let pipeline = coseg::pipeline::ShapePipelineOptions {
+        spectrum: options.clone(),
+        ..Default::default()
+    };
+    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &pipeline) {
+        eprintln!("warning: {}: {w}", args.mesh.display());
+    }
+    let options = SpectrumOptions {
+        eigenpairs: options.eigenpairs.min(available_eigenpairs(&mesh)),
+        ..options
     };
     let (spectrum, stats) = laplace_beltrami_spectrum_with_stats(&mesh, &options)
         .with_context(|| format!("{}: spectrum", args.mesh.display()))?;

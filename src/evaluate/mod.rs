@@ -40,7 +40,7 @@ pub use label_agreement::{
 };
 pub use part_coverage::part_coverage;
 pub use part_purity::part_purity;
-pub use read_labels::read_labels;
+pub use read_labels::{parse_labels, read_labels};
 
 use crate::mesh::TriMesh;
 use std::collections::BTreeMap;

@@ -19,21 +19,36 @@ use std::path::Path;
 /// ```
 pub fn read_labels(path: impl AsRef<Path>) -> Result<Vec<i32>, EvaluateError> {
     let path = path.as_ref();
-    let text = std::fs::read_to_string(path).map_err(|source| EvaluateError::Io {
+    let bytes = std::fs::read(path).map_err(|source| EvaluateError::Io {
         path: path.display().to_string(),
         source,
     })?;
-    let mut labels = Vec::with_capacity(text.len() / 2);
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim();
+    parse_labels(&bytes, &path.display().to_string())
+}
+
+/// [`read_labels`] on bytes held in memory; errors name `name`. Never panics, whatever the
+/// bytes (text that is not UTF-8 is an error naming its first bad line).
+///
+/// ```
+/// use coseg::evaluate::parse_labels;
+/// assert_eq!(parse_labels(b"1\n\n 2 \r\n", "x.txt").unwrap(), vec![1, 2]);
+/// assert!(parse_labels(b"1\n\xff\n", "x.txt").unwrap_err().to_string().contains("x.txt:2:"));
+/// ```
+pub fn parse_labels(bytes: &[u8], name: &str) -> Result<Vec<i32>, EvaluateError> {
+    let mut labels = Vec::with_capacity(bytes.len() / 2);
+    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
+        let bad = |text: String| EvaluateError::BadLabel {
+            path: name.to_string(),
+            line: i + 1,
+            text,
+        };
+        let t = std::str::from_utf8(line)
+            .map_err(|_| bad(String::from_utf8_lossy(line).chars().take(40).collect()))?
+            .trim();
         if t.is_empty() {
             continue;
         }
-        labels.push(t.parse().map_err(|_| EvaluateError::BadLabel {
-            path: path.display().to_string(),
-            line: i + 1,
-            text: t.to_string(),
-        })?);
+        labels.push(t.parse().map_err(|_| bad(t.chars().take(40).collect()))?);
     }
     Ok(labels)
 }

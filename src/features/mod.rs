@@ -16,21 +16,31 @@
 //! The common call is [`descriptors`] with [`DescriptorOptions::default`] (100 HKS + 100 WKS +
 //! 100 mean-curvature scales, as in the paper).
 
+mod columns;
 mod descriptors;
 mod export;
+mod extrinsic;
 mod heat_kernel_signature;
 mod mean_curvature;
 mod multiscale_mean_curvature;
 mod scale_grid;
+mod sdf;
 mod spectral_product;
+mod user;
 mod wave_kernel_signature;
 
+pub use columns::FeatureColumns;
 pub use descriptors::{DescriptorOptions, Descriptors, FeatureKind, descriptors};
 pub use export::{ExportFormat, ExportOptions, export_features};
+pub use extrinsic::{
+    Alignment, Axis, ExtrinsicOptions, Frame, extrinsic_features, height_directions, shape_frame,
+};
 pub use heat_kernel_signature::heat_kernel_signature;
 pub use mean_curvature::mean_curvature;
 pub use multiscale_mean_curvature::multiscale_mean_curvature;
 pub use scale_grid::{ScaleGrid, SpectralBand, scale_grid};
+pub use sdf::{SdfOptions, shape_diameter};
+pub use user::{read_user_features, user_feature_path};
 pub use wave_kernel_signature::wave_kernel_signature;
 
 use thiserror::Error;
@@ -52,6 +62,17 @@ pub enum FeatureError {
     /// A scale option is out of range (non-positive or non-finite bound, empty range…).
     #[error("invalid scale option: {0}")]
     BadScale(String),
+    /// An option of a feature family is invalid.
+    #[error("invalid feature option: {0}")]
+    BadOption(String),
+    /// A user feature file is missing, unreadable or malformed.
+    #[error("{path}: {message}")]
+    UserFile {
+        /// The file concerned.
+        path: String,
+        /// What is wrong.
+        message: String,
+    },
     /// A file could not be written.
     #[error("{path}: {source}")]
     Io {

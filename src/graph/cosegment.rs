@@ -573,7 +573,7 @@ fn check(graph: &ShapeGraph, options: &CosegmentOptions) -> Result<(), GraphErro
 }
 
 /// Root and breadth-first spanning tree of the graph.
-fn spanning_tree(
+pub(super) fn spanning_tree(
     graph: &ShapeGraph,
     root: Option<usize>,
 ) -> (usize, Vec<usize>, Vec<Option<usize>>) {
@@ -606,7 +606,7 @@ fn spanning_tree(
     (root, order, parent)
 }
 
-fn seed_region(
+pub(super) fn seed_region(
     graph: &ShapeGraph,
     root: usize,
     rem: &[u32],
@@ -649,7 +649,7 @@ fn seed_region(
     }
 }
 
-fn remove_sorted(from: &mut Vec<u32>, remove: &[u32]) {
+pub(super) fn remove_sorted(from: &mut Vec<u32>, remove: &[u32]) {
     let mut j = 0;
     from.retain(|&v| {
         while j < remove.len() && remove[j] < v {
@@ -659,7 +659,7 @@ fn remove_sorted(from: &mut Vec<u32>, remove: &[u32]) {
     });
 }
 
-fn area(areas: &[f64], v: &[u32]) -> f64 {
+pub(super) fn area(areas: &[f64], v: &[u32]) -> f64 {
     v.iter().map(|&p| areas[p as usize]).sum()
 }
 
@@ -671,7 +671,7 @@ fn iou(areas: &[f64], a: &[u32], b: &[u32]) -> f64 {
     if u > 0.0 { i / u } else { 1.0 }
 }
 
-fn tuple_hash(tuple: &[Vec<u32>]) -> [u8; 32] {
+pub(super) fn tuple_hash(tuple: &[Vec<u32>]) -> [u8; 32] {
     let mut h = blake3::Hasher::new();
     for r in tuple {
         h.update(&(r.len() as u64).to_le_bytes());
@@ -683,7 +683,7 @@ fn tuple_hash(tuple: &[Vec<u32>]) -> [u8; 32] {
 }
 
 /// The triangles `(i < j < k)` of the graph, a deterministic evenly spaced sample of `count`.
-fn sample_triangles(graph: &ShapeGraph, count: usize) -> Vec<[usize; 3]> {
+pub(super) fn sample_triangles(graph: &ShapeGraph, count: usize) -> Vec<[usize; 3]> {
     if count == 0 {
         return Vec::new();
     }
@@ -923,7 +923,7 @@ pub fn cosegment(
 
 /// Tree-edge agreement and triangle cycle consistency of a tuple (the engine's histograms hold
 /// the tuple's regions).
-fn confidence(
+pub(super) fn confidence(
     graph: &ShapeGraph,
     eng: &mut Engine<'_>,
     parent: &[Option<usize>],

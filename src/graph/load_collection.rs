@@ -1,12 +1,22 @@
 //! [`load_collection`]: a folder of meshes to shape-graph nodes through the per-shape cache.
+//!
+//! Two rules keep a folder's shapes what the user means them to be:
+//! - **coseg's own outputs are never inputs**: files named `*.regions.ply` (what `coseg segment`
+//!   and `coseg pair` write, see [`is_coseg_output`]) are left out and reported in
+//!   [`LoadedCollection::ignored`] and a warning, so `coseg segment same -o same` run twice
+//!   co-segments the same shapes both times;
+//! - **names are distinct**: a shape is named by its file stem, except that files sharing a
+//!   stem (ignoring case: `g.obj`, `g.off`) are named `<stem>_<extension>` (`g_obj`, `g_off`,
+//!   with `_2`, `_3`… appended should that still collide), with a warning ([`shape_names`]).
 
 use super::{GraphError, ShapeNode};
-use crate::cache::{CacheOutcome, ShapePipelineOptions, load_or_compute_bands};
-use crate::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
+use crate::cache::CacheOutcome;
+use crate::mesh::{MeshFormat, TriMesh};
+use crate::pipeline::{PipelineError, ShapeBands, ShapePipelineOptions, load_shape};
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
-use std::time::{Duration, Instant};
+use std::time::Duration;
 
 /// A file that could not be used, and why (the message names the file).
 #[derive(Debug, Clone, PartialEq)]
@@ -30,6 +40,8 @@ pub struct LoadedCollection {
     pub outcomes: Vec<CacheOutcome>,
     /// Files that failed to read or compute, in file order.
     pub skipped: Vec<SkippedFile>,
+    /// coseg's own output files found in the folder and not read ([`is_coseg_output`]).
+    pub ignored: Vec<PathBuf>,
     /// Warnings for the user (mesh warnings, stale cache entries, cache write failures).
     pub warnings: Vec<String>,
     /// Time spent reading meshes, summed over shapes (across threads: it can exceed the wall
@@ -40,34 +52,117 @@ pub struct LoadedCollection {
     pub shape_time: Duration,
 }
 
-/// The mesh files (`.obj`, `.off`, `.ply`, any case) directly in `folder`, sorted by file name.
+/// The mesh files (`.obj`, `.off`, `.ply`, any case) directly in `folder`, sorted by file name,
+/// without coseg's own output files ([`is_coseg_output`]).
 pub fn mesh_files(folder: &Path) -> Result<Vec<PathBuf>, GraphError> {
+    Ok(list_mesh_files(folder)?.0)
+}
+
+/// Whether `path` is named like a file coseg writes beside its results (`<name>.regions.ply`,
+/// any case), which must not be read back as a shape.
+///
+/// ```
+/// use coseg::graph::is_coseg_output;
+/// use std::path::Path;
+/// assert!(is_coseg_output(Path::new("out/cat.regions.ply")));
+/// assert!(!is_coseg_output(Path::new("shapes/cat.ply")));
+/// ```
+pub fn is_coseg_output(path: &Path) -> bool {
+    path.file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n.to_ascii_lowercase().ends_with(".regions.ply"))
+}
+
+/// The mesh files of `folder` (sorted) and, apart, the coseg outputs among them (sorted).
+fn list_mesh_files(folder: &Path) -> Result<(Vec<PathBuf>, Vec<PathBuf>), GraphError> {
     let io = |source| GraphError::Io {
         path: folder.display().to_string(),
         source,
     };
-    let mut out = Vec::new();
+    let (mut keep, mut ignored) = (Vec::new(), Vec::new());
     for entry in std::fs::read_dir(folder).map_err(io)? {
         let path = entry.map_err(io)?.path();
         if path.is_file() && MeshFormat::from_path(&path).is_some() {
-            out.push(path);
+            if is_coseg_output(&path) {
+                ignored.push(path);
+            } else {
+                keep.push(path);
+            }
         }
     }
-    out.sort();
-    Ok(out)
+    keep.sort();
+    ignored.sort();
+    Ok((keep, ignored))
+}
+
+/// Distinct shape names for `paths`, in order, and a warning per group of files that share a
+/// stem (see the module docs). Names are file stems where those are unique (ignoring case,
+/// so that outputs never collide on a case-insensitive file system).
+///
+/// ```
+/// use coseg::graph::shape_names;
+/// use std::path::PathBuf;
+/// let paths: Vec<PathBuf> = ["s/g.obj", "s/g.off", "s/h.ply"].iter().map(PathBuf::from).collect();
+/// let (names, warnings) = shape_names(&paths);
+/// assert_eq!(names, ["g_obj", "g_off", "h"]);
+/// assert_eq!(warnings.len(), 1);
+/// ```
+pub fn shape_names(paths: &[PathBuf]) -> (Vec<String>, Vec<String>) {
+    let stem = |p: &Path| {
+        p.file_stem()
+            .map_or_else(|| "shape".to_string(), |s| s.to_string_lossy().into_owned())
+    };
+    let stems: Vec<String> = paths.iter().map(|p| stem(p)).collect();
+    let lower: Vec<String> = stems.iter().map(|s| s.to_lowercase()).collect();
+    let mut names = stems.clone();
+    let mut warnings = Vec::new();
+    let mut reported = std::collections::HashSet::new();
+    for i in 0..paths.len() {
+        let group: Vec<usize> = (0..paths.len()).filter(|&j| lower[j] == lower[i]).collect();
+        if group.len() < 2 {
+            continue;
+        }
+        let ext = paths[i]
+            .extension()
+            .map_or_else(String::new, |e| e.to_string_lossy().to_lowercase());
+        names[i] = format!("{}_{ext}", stems[i]);
+        if reported.insert(lower[i].clone()) {
+            let files: Vec<String> = group
+                .iter()
+                .map(|&j| paths[j].display().to_string())
+                .collect();
+            warnings.push(format!(
+                "{} share the stem \"{}\": their outputs are named <stem>_<extension>",
+                files.join(", "),
+                stems[i]
+            ));
+        }
+    }
+    let mut used = std::collections::HashSet::new();
+    for name in names.iter_mut() {
+        let base = name.clone();
+        let mut n = 2;
+        while !used.insert(name.to_lowercase()) {
+            *name = format!("{base}_{n}");
+            n += 1;
+        }
+    }
+    (names, warnings)
 }
 
 /// Reads every mesh file of `folder` ([`mesh_files`]) and gets its band table through the
-/// per-shape cache in `cache_dir` ([`crate::cache::load_or_compute_bands`]: only the band
+/// per-shape cache in `cache_dir` ([`crate::pipeline::load_shape`] of
+/// [`crate::pipeline::ShapeBands`]: only the band
 /// tables and vertex areas are read when the cache is warm). Shapes are processed in
 /// parallel on rayon's pool (one shape per thread: the per-shape work is independent, so the
 /// result is the same whatever the thread count); the result keeps file order. Files that fail
 /// to read or compute are reported in [`LoadedCollection::skipped`], not fatal.
 /// `progress(started, total, path)` is called when a file starts (from the worker threads, one
-/// call at a time). Nodes are named by file stem.
+/// call at a time). Nodes are named by [`shape_names`]; coseg's own outputs are not read (see
+/// the module docs).
 ///
 /// ```no_run
-/// use coseg::cache::ShapePipelineOptions;
+/// use coseg::pipeline::ShapePipelineOptions;
 /// use coseg::graph::load_collection;
 /// use std::path::Path;
 /// let c = load_collection(Path::new("shapes"), &ShapePipelineOptions::default(),
@@ -80,29 +175,44 @@ pub fn load_collection(
     cache_dir: &Path,
     progress: impl FnMut(usize, usize, &Path) + Send,
 ) -> Result<LoadedCollection, GraphError> {
-    let files = mesh_files(folder)?;
+    let (files, ignored) = list_mesh_files(folder)?;
+    let (names, name_warnings) = shape_names(&files);
     let mut out = LoadedCollection {
         paths: Vec::new(),
         meshes: Vec::new(),
         nodes: Vec::new(),
         outcomes: Vec::new(),
         skipped: Vec::new(),
-        warnings: Vec::new(),
+        warnings: name_warnings,
+        ignored,
         read_time: Duration::ZERO,
         shape_time: Duration::ZERO,
     };
+    if !out.ignored.is_empty() {
+        let list: Vec<String> = out
+            .ignored
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        out.warnings.push(format!(
+            "{}: not reading {} file(s) coseg wrote as results (*.regions.ply): {}",
+            folder.display(),
+            list.len(),
+            list.join(", ")
+        ));
+    }
     let total = files.len();
     let started = Mutex::new((0usize, progress));
     let results: Vec<ShapeResult> = files
         .into_par_iter()
-        .enumerate()
-        .map(|(i, path)| {
+        .zip(names)
+        .map(|(path, name)| {
             if let Ok(mut guard) = started.lock() {
                 let (count, report) = &mut *guard;
                 report(*count, total, &path);
                 *count += 1;
             }
-            load_one(i, path, options, cache_dir)
+            load_one(name, path, options, cache_dir)
         })
         .collect();
     for r in results {
@@ -132,7 +242,7 @@ struct ShapeResult {
 }
 
 fn load_one(
-    i: usize,
+    name: String,
     path: PathBuf,
     options: &ShapePipelineOptions,
     cache_dir: &Path,
@@ -153,36 +263,24 @@ fn load_one(
             error,
         })
     };
-    let t = Instant::now();
-    let read = read_mesh_with_report(&path);
-    r.read_time = t.elapsed();
-    let (mesh, report) = match read {
+    let res = match load_shape::<ShapeBands>(&path, options, Some(cache_dir)) {
         Ok(x) => x,
-        Err(e) => {
+        Err(PipelineError::Mesh(e)) => {
             r.outcome = skip(e.to_string());
             return r;
         }
-    };
-    for w in &report.warnings {
-        r.warnings.push(format!("{}: {w}", path.display()));
-    }
-    let t = Instant::now();
-    let data = load_or_compute_bands(&mesh, options, cache_dir);
-    r.shape_time = t.elapsed();
-    let res = match data {
-        Ok(x) => x,
         Err(e) => {
             r.outcome = skip(format!("{}: {e}", path.display()));
             return r;
         }
     };
-    r.warnings.extend(res.warnings);
-    let name = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_else(|| format!("shape{i}"));
+    r.read_time = res.read_time;
+    r.shape_time = res.shape_time;
+    r.warnings = res.warnings;
+    let outcome = res.outcome.unwrap_or(CacheOutcome::Miss);
+    let mesh = res.mesh;
     r.outcome = match ShapeNode::new(name, res.data.bands, &res.data.vertex_areas) {
-        Ok(node) => Ok((mesh, node, res.outcome)),
+        Ok(node) => Ok((mesh, node, outcome)),
         Err(e) => skip(format!("{}: {e}", path.display())),
     };
     r

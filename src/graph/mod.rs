@@ -9,12 +9,15 @@
 //!   feature pairing and a weight; pairwise affinities exist only as band-table operators.
 //! - [`cosegment`]: consistent region tuples across every shape of the graph (design argued
 //!   in that function's module).
+//! - [`adaptive_cosegment`]: the same with each tuple's size found from the data
+//!   (Algorithm 3 across the graph), the number of parts from the data and a tree of parts.
 //! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
 //!   boundaries over every edge of the graph.
 //! - [`segment_collection`]: graph, co-segmentation and refinement in one call, as
 //!   `coseg segment` runs them.
 //! - [`load_collection`]: a folder of meshes to graph nodes through the per-shape cache.
 
+mod adaptive_cosegment;
 mod cosegment;
 mod cycle_consistency;
 mod load_collection;
@@ -23,9 +26,15 @@ mod segment_collection;
 mod shape_graph;
 mod stable_cycle;
 
+pub use adaptive_cosegment::{
+    AdaptiveCosegmentation, AdaptiveOptions, AutoTuple, PartMerge, PartTree, PartsReport, Sizing,
+    StopReason, adaptive_cosegment, adaptive_update,
+};
 pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
 pub use cycle_consistency::{CycleConsistency, cycle_consistency};
-pub use load_collection::{LoadedCollection, SkippedFile, load_collection, mesh_files};
+pub use load_collection::{
+    LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
+};
 pub use refine_cosegmentation::refine_cosegmentation;
 pub use segment_collection::{
     SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection,

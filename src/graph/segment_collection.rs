@@ -2,7 +2,10 @@
 //! [`cosegment`] → heat smoothers → [`refine_cosegmentation`]), as `coseg segment` runs it.
 
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
-use super::{CosegmentOptions, Cosegmentation, GraphError, cosegment, refine_cosegmentation};
+use super::{
+    AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
+    adaptive_cosegment, cosegment, refine_cosegmentation,
+};
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
 use crate::stable::RefineOptions;
@@ -19,6 +22,11 @@ pub struct SegmentCollectionOptions {
     /// Boundary refinement after the co-segmentation; `None` keeps the raw region tuples.
     /// Default: [`SegmentCollectionOptions::DEFAULT_REFINE`].
     pub refine: Option<RefineOptions>,
+    /// `Some`: parts of their own size by [`super::adaptive_cosegment`] (then cut at
+    /// [`AdaptiveOptions::parts`] parts when set) instead of [`cosegment`]'s equal areas;
+    /// `cosegment` is ignored. Default `None`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub parts: Option<AdaptiveOptions>,
 }
 
 impl SegmentCollectionOptions {
@@ -39,6 +47,7 @@ impl Default for SegmentCollectionOptions {
             graph: GraphOptions::default(),
             cosegment: CosegmentOptions::default(),
             refine: Some(Self::DEFAULT_REFINE),
+            parts: None,
         }
     }
 }
@@ -65,6 +74,8 @@ pub struct SegmentedCollection {
     pub segmentation: Cosegmentation,
     /// Per-stage wall times.
     pub times: SegmentTimes,
+    /// The adaptive run (finest parts, thresholds, tree) when `options.parts` was set.
+    pub adaptive: Option<AdaptiveCosegmentation>,
 }
 
 /// Co-segments a collection: builds the shape graph over `nodes`, extracts consistent region
@@ -118,7 +129,13 @@ pub fn segment_collection(
     let graph = ShapeGraph::build(nodes, &options.graph)?;
     times.graph = t.elapsed();
     let t = Instant::now();
-    let mut segmentation = cosegment(&graph, &options.cosegment)?;
+    let (mut segmentation, adaptive) = match &options.parts {
+        None => (cosegment(&graph, &options.cosegment)?, None),
+        Some(p) => {
+            let a = adaptive_cosegment(&graph, p)?;
+            (a.cut(p.parts.unwrap_or(usize::MAX)), Some(a))
+        }
+    };
     times.cosegment = t.elapsed();
     if let Some(refine) = options.refine.as_ref().filter(|r| r.max_rounds > 0) {
         let t = Instant::now();
@@ -148,5 +165,6 @@ pub fn segment_collection(
         graph,
         segmentation,
         times,
+        adaptive,
     })
 }

@@ -44,6 +44,12 @@ pub enum MeshWarning {
         /// Number of boundary edges.
         edges: usize,
     },
+    /// The file holds data the reader skipped (an OFF file's lines after the elements its
+    /// header declares): the mesh is what the header declares.
+    IgnoredData {
+        /// What was skipped and where (line number).
+        message: String,
+    },
 }
 
 impl fmt::Display for MeshWarning {
@@ -70,6 +76,7 @@ impl fmt::Display for MeshWarning {
                 write!(f, "{count} connected components")
             }
             MeshWarning::Boundary { edges } => write!(f, "open surface: {edges} boundary edges"),
+            MeshWarning::IgnoredData { message } => write!(f, "ignored: {message}"),
         }
     }
 }

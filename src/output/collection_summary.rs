@@ -82,6 +82,10 @@ pub struct CollectionSummary {
     pub options: SegmentCollectionOptions,
     /// Input files that were skipped, with the reason.
     pub skipped: Vec<SkippedInput>,
+    /// With `--parts`: the adaptive run's thresholds, stop reason, tree and mirror
+    /// candidates (absent otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub parts: Option<crate::graph::PartsReport>,
 }
 
 impl CollectionSummary {
@@ -158,6 +162,7 @@ impl CollectionSummary {
             edges,
             options: options.clone(),
             skipped,
+            parts: None,
         }
     }
 }

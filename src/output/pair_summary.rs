@@ -1,8 +1,8 @@
 //! [`PairSummary`]: the `summary.json` of a two-shape stable-region run.
 
-use crate::stable::{
-    MapGuidedOptions, PresetChoice, RefineOptions, StableRegions, StableRegionsOptions,
-};
+use crate::maps::MapGuidedOptions;
+use crate::maps::PresetChoice;
+use crate::stable::{RefineOptions, StableRegions, StableRegionsOptions, StageFallback};
 use serde::Serialize;
 
 /// One shape of a pair run.
@@ -55,8 +55,12 @@ pub struct PairSummary {
     /// [`map_guided_refinement`](crate::stable::map_guided_refinement)).
     pub map_guided: Option<MapGuidedOptions>,
     /// Which preset the map step's options came from and the pair's eigenvalue discrepancy
-    /// (see [`map_preset`](crate::stable::map_preset)), when the step ran.
+    /// (see [`map_preset`](crate::maps::map_preset)), when the step ran.
     pub map_preset: Option<PresetChoice>,
+    /// The requested optional stages (`refine`, `map_guided`) that could not run on these
+    /// shapes and left the previous stage's regions, each with the reason; empty when every
+    /// requested stage ran (see [`segment_pair`](crate::stable::segment_pair)).
+    pub fallbacks: Vec<StageFallback>,
     /// Per-region statistics, in region-id order.
     pub regions: Vec<RegionSummary>,
     /// Correspondence ratio against the given ground truth, if any (fraction in `[0, 1]`).
@@ -108,6 +112,7 @@ impl PairSummary {
             refine: None,
             map_guided: None,
             map_preset: None,
+            fallbacks: Vec::new(),
             regions,
             correspondence_ratio,
             seconds,
@@ -131,6 +136,12 @@ impl PairSummary {
     /// Records the map step's preset choice.
     pub fn with_map_preset(mut self, choice: Option<PresetChoice>) -> Self {
         self.map_preset = choice;
+        self
+    }
+
+    /// Records the optional stages that fell back (see [`PairSummary::fallbacks`]).
+    pub fn with_fallbacks(mut self, fallbacks: Vec<StageFallback>) -> Self {
+        self.fallbacks = fallbacks;
         self
     }
 }

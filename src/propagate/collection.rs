@@ -1,10 +1,10 @@
 //! [`propagate_collection`]: a folder of meshes and its label files in one call.
 
 use super::{PropagateError, PropagateOptions, Propagation, propagate_labels};
-use crate::cache::ShapePipelineOptions;
 use crate::graph::{GraphOptions, ShapeGraph, SkippedFile, load_collection};
 use crate::labels::{LabelKind, PartNames, match_label_files, read_part_names, read_shape_labels};
 use crate::mesh::TriMesh;
+use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
 use rayon::prelude::*;
 use std::path::{Path, PathBuf};

@@ -116,6 +116,23 @@ pub fn laplace_beltrami_spectrum(
     laplace_beltrami_spectrum_with_stats(mesh, options).map(|(s, _)| s)
 }
 
+/// The most eigenpairs [`laplace_beltrami_spectrum`] can return for `mesh`: its vertices of
+/// positive mass (vertices used by no triangle of positive area carry none). A mesh of 4
+/// vertices has 4 eigenpairs, whatever was asked for.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, spectral::available_eigenpairs};
+/// // Two triangles and one vertex no face uses.
+/// let m = TriMesh::new(
+///     vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.], [5., 5., 5.]],
+///     vec![[0, 1, 2], [0, 2, 3]],
+/// ).unwrap();
+/// assert_eq!(available_eigenpairs(&m), 4);
+/// ```
+pub fn available_eigenpairs(mesh: &TriMesh) -> usize {
+    lumped_mass(mesh).iter().filter(|&&m| m > 0.0).count()
+}
+
 /// What [`laplace_beltrami_spectrum_with_stats`] did: path taken, sizes, iteration counts and
 /// wall-clock seconds per phase (for benchmarks and diagnostics; timings vary run to run, the
 /// spectrum does not).

@@ -5,26 +5,20 @@
 //! eigenvalues, diffusion times and energies mean the same on every shape of a collection,
 //! whatever the units of its file. Eigenvectors are M-orthonormal for the unit-area mass.
 
-mod auction_assignment;
 mod block_lanczos;
 mod cotan_laplacian;
-mod eigenvalue_discrepancy;
 mod heat_smoother;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
 mod shift_invert;
-pub(crate) mod zoomout;
 
-pub use auction_assignment::{Assignment, AuctionOptions, CandidateLists, auction_assignment};
 pub use cotan_laplacian::cotan_laplacian;
-pub use eigenvalue_discrepancy::eigenvalue_discrepancy;
 pub use heat_smoother::HeatSmoother;
 pub use laplace_beltrami_spectrum::{
-    SpectrumOptions, SpectrumStats, dense_spectrum, laplace_beltrami_spectrum,
-    laplace_beltrami_spectrum_with_stats,
+    SpectrumOptions, SpectrumStats, available_eigenpairs, dense_spectrum,
+    laplace_beltrami_spectrum, laplace_beltrami_spectrum_with_stats,
 };
 pub use lumped_mass::lumped_mass;
-pub use zoomout::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
 
 use thiserror::Error;
 

@@ -2,54 +2,10 @@
 //! affinity together with a point map read from the region correspondence itself.
 
 use super::refine_regions::rebuild_regions;
-use super::{
-    MapShape, PointMapOptions, StableError, StableRegions, region_point_map, region_scores,
-};
+use super::{StableError, StableRegions, region_scores};
 use crate::affinity::{BandAffinity, Direction};
-use crate::spectral::{HeatSmoother, ShapeGeometry};
-use serde::{Deserialize, Serialize};
-
-/// Options of [`map_guided_refinement`].
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct MapGuidedOptions {
-    /// The point map's options.
-    pub point_map: PointMapOptions,
-    /// Weight `β` of the point map's vote against the band affinity, which is scaled to a
-    /// best score of 1 at every vertex (default 0.5; `0` ignores the map).
-    pub map_weight: f64,
-    /// Heat-smoothing time of the blended scores (unit-area surface; default `1e-3`, shorter
-    /// than the refinement's: the map already places boundaries smoothly). The smoother given
-    /// to [`map_guided_refinement`] should have this time ([`segment_pair`](super::segment_pair)
-    /// builds it); `0` disables smoothing.
-    pub smoothing_time: f64,
-}
-
-impl MapGuidedOptions {
-    /// The map step for near-isometric pairs (two poses of one body): a vote of weight 2 and
-    /// a point map whose last match also compares the descriptors (weight 500, see
-    /// [`ZoomOutOptions::descriptor_weight`](crate::spectral::ZoomOutOptions)). On the TOSCA
-    /// within-class pairs it scores best (94.6 % against 94.0 % for the default, README); on
-    /// shapes that are not near-isometric it trusts the map too much (the shipped quadruped
-    /// pair loses 4 points of part purity), hence not the default.
-    pub fn near_isometric() -> Self {
-        let mut options = Self {
-            map_weight: 2.0,
-            ..Self::default()
-        };
-        options.point_map.zoomout.descriptor_weight = 500.0;
-        options
-    }
-}
-
-impl Default for MapGuidedOptions {
-    fn default() -> Self {
-        MapGuidedOptions {
-            point_map: PointMapOptions::default(),
-            map_weight: 0.5,
-            smoothing_time: 1e-3,
-        }
-    }
-}
+use crate::maps::{MapGuidedOptions, MapShape, ShapeGeometry, region_point_map};
+use crate::spectral::HeatSmoother;
 
 /// Sharpens B's side of corresponding partitions with a point map. A's regions are kept; every
 /// vertex `q` of B takes the region `r` maximising, after heat smoothing over B,
@@ -74,9 +30,10 @@ impl Default for MapGuidedOptions {
 /// ```no_run
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// use coseg::affinity::BandAffinity;
-/// use coseg::cache::{compute_shape_data, ShapePipelineOptions};
+/// use coseg::pipeline::{compute_shape_data, ShapePipelineOptions};
 /// use coseg::mesh::read_mesh;
 /// use coseg::spectral::HeatSmoother;
+/// use coseg::maps::{MapShape, PointMapOptions, ShapeGeometry};
 /// use coseg::stable::*;
 /// let (ma, mb) = (read_mesh("cat0.off")?, read_mesh("cat1.off")?);
 /// let pipe = ShapePipelineOptions::default();
@@ -156,7 +113,7 @@ pub fn map_guided_refinement(
 
 /// The blend of [`map_guided_refinement`] with a point map `map` from B to A given by the
 /// caller (`map[q]` is a vertex of A for every vertex `q` of B), for instance one from
-/// another correspondence method or [`zoomout`](crate::spectral::zoomout) from a known map.
+/// another correspondence method or [`zoomout`](crate::maps::zoomout) from a known map.
 /// `areas_a`, `areas_b` are the vertex areas the rebuilt pairs' area fractions use; `β` is
 /// `map_weight`.
 ///

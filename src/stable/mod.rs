@@ -8,7 +8,7 @@
 //! - [`stable_regions`]: one call from two band tables.
 //! - [`refine_partition`]: smoothed best-response refinement of two corresponding partitions.
 //! - [`refine_regions`]: the same on the output of Algorithms 2 and 3.
-//! - [`region_point_map`]: a vertex map from corresponding regions (functional map + ZoomOut).
+//! - [`region_point_map`](crate::maps::region_point_map): a vertex map from corresponding regions (functional map + ZoomOut), in [`crate::maps`].
 //! - [`map_guided_refinement`]: B's regions re-assigned by band affinity and that map
 //!   ([`point_map_refinement`]: the same with a map of your own).
 //! - [`segment_pair`]: the whole pair stage in one call (algorithm → refinement → map step).
@@ -17,10 +17,8 @@
 mod correspondence_ratio;
 mod initial_indicator;
 mod map_guided_refinement;
-mod map_preset;
 mod refine_partition;
 mod refine_regions;
-mod region_point_map;
 mod segment_pair;
 mod stable_pair;
 mod stable_pairs_auto;
@@ -28,21 +26,18 @@ mod stable_pairs_fixed;
 mod stable_regions;
 mod threshold;
 
-pub use crate::spectral::ShapeGeometry;
 pub use correspondence_ratio::{
     CorrespondenceStats, VertexMap, correspondence_ratio, correspondence_stats,
 };
 pub use initial_indicator::{Init, initial_indicator};
-pub use map_guided_refinement::{MapGuidedOptions, map_guided_refinement, point_map_refinement};
-pub use map_preset::{
-    MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PRESET_EIGENVALUES, PresetChoice, map_preset,
-};
+pub use map_guided_refinement::{map_guided_refinement, point_map_refinement};
 pub use refine_partition::{
     RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
 };
 pub use refine_regions::refine_regions;
-pub use region_point_map::{MapShape, PointMapOptions, region_point_map};
-pub use segment_pair::{PairShape, PairTimes, SegmentPairOptions, SegmentedPair, segment_pair};
+pub use segment_pair::{
+    PairShape, PairStage, PairTimes, SegmentPairOptions, SegmentedPair, StageFallback, segment_pair,
+};
 pub use stable_pair::{
     Remaining, StablePair, StablePairOptions, StableWorkspace, stable_pair, stable_pair_with,
 };
@@ -86,6 +81,9 @@ pub enum StableError {
     /// The spectral stage (a smoother or a spectral map) rejected its input.
     #[error(transparent)]
     Spectral(#[from] crate::spectral::SpectralError),
+    /// The correspondence-map stage rejected its input.
+    #[error(transparent)]
+    Map(#[from] crate::maps::MapError),
     /// A ground-truth map is malformed or unreadable (names the file when there is one).
     #[error("ground-truth map: {0}")]
     BadMap(String),

@@ -2,18 +2,20 @@
 //! [`refine_regions`] → [`map_guided_refinement`]), as `coseg pair` runs it.
 
 use super::{
-    MapGuidedOptions, RefineOptions, StableError, StableRegions, StableRegionsOptions,
-    map_guided_refinement, refine_regions, stable_regions,
+    RefineOptions, StableError, StableRegions, StableRegionsOptions, map_guided_refinement,
+    refine_regions, stable_regions,
 };
 use crate::affinity::BandAffinity;
 use crate::bands::BandTable;
+use crate::maps::MapGuidedOptions;
+use crate::maps::ShapeGeometry;
 use crate::mesh::TriMesh;
-use crate::spectral::{HeatSmoother, ShapeGeometry, Spectrum};
+use crate::spectral::{HeatSmoother, Spectrum};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 /// Options of [`segment_pair`]. The defaults suit any pair; `coseg pair` replaces the map
-/// step's options by those [`map_preset`](super::map_preset) picks from the two spectra
+/// step's options by those [`map_preset`](crate::maps::map_preset) picks from the two spectra
 /// (`MapPreset::options`), which on two poses of one body is the configuration that scores
 /// best on the TOSCA within-class pairs (README, "Correspondence ratio").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -40,7 +42,7 @@ impl Default for SegmentPairOptions {
 }
 
 /// One shape as [`segment_pair`] needs it: the mesh, and the spectrum and band table computed
-/// from it (e.g. [`compute_shape_data`](crate::cache::compute_shape_data)).
+/// from it (e.g. [`compute_shape_data`](crate::pipeline::compute_shape_data)).
 #[derive(Debug, Clone, Copy)]
 pub struct PairShape<'a> {
     /// The mesh (vertex areas, positions, and the heat smoothers' Laplacian).
@@ -50,7 +52,7 @@ pub struct PairShape<'a> {
     /// Its `d × N` band table.
     pub bands: &'a BandTable,
     /// Its descriptors, feature-major (`Descriptors::values`); optional, they sharpen the map
-    /// step's point map (see [`ZoomOutOptions::descriptor_weight`](crate::spectral::ZoomOutOptions)).
+    /// step's point map (see [`ZoomOutOptions::descriptor_weight`](crate::maps::ZoomOutOptions)).
     pub descriptors: Option<&'a [f64]>,
 }
 
@@ -84,17 +86,25 @@ pub struct SegmentedPair {
     pub regions: StableRegions,
     /// Per-stage wall times.
     pub times: PairTimes,
+    /// The optional stages that could not run on these shapes (each kept the previous
+    /// stage's regions), in stage order; empty when every requested stage ran.
+    pub fallbacks: Vec<StageFallback>,
 }
 
 /// Stable region correspondences between two shapes: Algorithm 2 or 3 ([`stable_regions`]),
 /// then (by default) [`refine_regions`] and [`map_guided_refinement`], with heat smoothers
 /// built on the meshes at the stages' smoothing times.
 ///
+/// The two later stages are optional: one that cannot run on these shapes (a smoother that
+/// cannot be factored, a map that cannot be fitted) leaves the previous stage's regions and is
+/// listed in [`SegmentedPair::fallbacks`] with the reason. Errors are the algorithm's and
+/// invalid options only.
+///
 /// Deterministic: the same shapes and options give the same regions, bit for bit.
 ///
 /// ```no_run
 /// # fn main() -> Result<(), Box<dyn std::error::Error>> {
-/// use coseg::cache::{compute_shape_data, ShapePipelineOptions};
+/// use coseg::pipeline::{compute_shape_data, ShapePipelineOptions};
 /// use coseg::mesh::read_mesh;
 /// use coseg::stable::{segment_pair, PairShape, SegmentPairOptions};
 /// let (ma, mb) = (read_mesh("cat0.off")?, read_mesh("cat1.off")?);
@@ -122,7 +132,9 @@ pub fn segment_pair(
             )));
         }
     }
+    check_stage_options(options)?;
     let mut times = PairTimes::default();
+    let mut fallbacks = Vec::new();
     let (areas_a, areas_b) = (a.mesh.vertex_areas(), b.mesh.vertex_areas());
     let t = Instant::now();
     let mut regions = stable_regions(a.bands, b.bands, &areas_a, &areas_b, &options.regions)?;
@@ -130,51 +142,170 @@ pub fn segment_pair(
     let refine = options.refine.as_ref().filter(|r| r.max_rounds > 0);
     let map_guided = options.map_guided.as_ref();
     if refine.is_none() && map_guided.is_none() {
-        return Ok(SegmentedPair { regions, times });
+        return Ok(SegmentedPair {
+            regions,
+            times,
+            fallbacks,
+        });
     }
-    let t = Instant::now();
+    let w = match BandAffinity::new(a.bands, b.bands) {
+        Ok(w) => w,
+        Err(e) => {
+            let reason = e.to_string();
+            for (stage, on) in [
+                (PairStage::Refine, refine.is_some()),
+                (PairStage::MapGuided, map_guided.is_some()),
+            ] {
+                if on {
+                    fallbacks.push(StageFallback::new(stage, &reason));
+                }
+            }
+            return Ok(SegmentedPair {
+                regions,
+                times,
+                fallbacks,
+            });
+        }
+    };
     let smoother = |mesh: &TriMesh, time: f64| -> Result<Option<HeatSmoother>, StableError> {
         Ok((time > 0.0)
             .then(|| HeatSmoother::new(mesh, time))
             .transpose()?)
     };
-    let refine_smoothers = match refine {
-        Some(r) => (
-            smoother(a.mesh, r.smoothing_time)?,
-            smoother(b.mesh, r.smoothing_time)?,
-        ),
-        None => (None, None),
-    };
-    let map_smoother = match map_guided {
-        Some(m) => smoother(b.mesh, m.smoothing_time)?,
-        None => None,
-    };
-    times.smoothers = t.elapsed();
-    let w = BandAffinity::new(a.bands, b.bands)?;
     if let Some(refine) = refine {
         let t = Instant::now();
-        regions = refine_regions(
-            &w,
-            &regions,
-            &areas_a,
-            &areas_b,
-            refine_smoothers.0.as_ref(),
-            refine_smoothers.1.as_ref(),
-            refine,
-        )?;
-        times.refine = t.elapsed();
+        let result = (|| {
+            let (sa, sb) = (
+                smoother(a.mesh, refine.smoothing_time)?,
+                smoother(b.mesh, refine.smoothing_time)?,
+            );
+            times.smoothers += t.elapsed();
+            let t = Instant::now();
+            let out = refine_regions(
+                &w,
+                &regions,
+                &areas_a,
+                &areas_b,
+                sa.as_ref(),
+                sb.as_ref(),
+                refine,
+            );
+            times.refine = t.elapsed();
+            out
+        })();
+        match result {
+            Ok(r) => regions = r,
+            Err(e) => fallbacks.push(StageFallback::new(PairStage::Refine, &e.to_string())),
+        }
     }
     if let Some(map_guided) = map_guided {
         let t = Instant::now();
-        regions = map_guided_refinement(
-            &w,
-            &regions,
-            a.geometry(),
-            b.geometry(),
-            map_smoother.as_ref(),
-            map_guided,
-        )?;
-        times.map_guided = t.elapsed();
+        let result = (|| {
+            let sb = smoother(b.mesh, map_guided.smoothing_time)?;
+            times.smoothers += t.elapsed();
+            let t = Instant::now();
+            let out = map_guided_refinement(
+                &w,
+                &regions,
+                a.geometry(),
+                b.geometry(),
+                sb.as_ref(),
+                &fit_map_sizes(map_guided, a.spectrum.len().min(b.spectrum.len())),
+            );
+            times.map_guided = t.elapsed();
+            out
+        })();
+        match result {
+            Ok(r) => regions = r,
+            Err(e) => fallbacks.push(StageFallback::new(PairStage::MapGuided, &e.to_string())),
+        }
     }
-    Ok(SegmentedPair { regions, times })
+    Ok(SegmentedPair {
+        regions,
+        times,
+        fallbacks,
+    })
+}
+
+/// The options' own ranges, checked before any stage runs: a wrong option is the caller's
+/// error, not a reason for a stage to fall back.
+fn check_stage_options(options: &SegmentPairOptions) -> Result<(), StableError> {
+    let non_negative = |name: &str, x: f64| {
+        if x.is_finite() && x >= 0.0 {
+            Ok(())
+        } else {
+            Err(StableError::BadOption(format!(
+                "{name} = {x} must be finite and non-negative"
+            )))
+        }
+    };
+    if let Some(r) = &options.refine {
+        non_negative("refine smoothing_time", r.smoothing_time)?;
+    }
+    if let Some(m) = &options.map_guided {
+        non_negative("map_weight", m.map_weight)?;
+        non_negative("map smoothing_time", m.smoothing_time)?;
+        let z = &m.point_map.zoomout;
+        if z.initial_size == 0 || z.step == 0 || z.initial_size > z.final_size {
+            return Err(StableError::BadOption(format!(
+                "map sizes: initial {} and step {} must be positive, and the initial size at \
+                 most the final size {}",
+                z.initial_size, z.step, z.final_size
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The map step's options with its first map no larger than the eigenpairs both shapes have
+/// (`available`): a small mesh has fewer eigenpairs than the default first size, and a
+/// smaller first map is what the step can fit there.
+fn fit_map_sizes(options: &MapGuidedOptions, available: usize) -> MapGuidedOptions {
+    let mut options = options.clone();
+    let z = &mut options.point_map.zoomout;
+    z.initial_size = z.initial_size.min(available).max(1);
+    options
+}
+
+/// An optional stage of [`segment_pair`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PairStage {
+    /// [`refine_regions`].
+    Refine,
+    /// [`map_guided_refinement`].
+    MapGuided,
+}
+
+/// An optional stage that could not run on these shapes: the result is the previous stage's,
+/// and `reason` (a sentence for the user) says why.
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct StageFallback {
+    /// The stage that was skipped.
+    pub stage: PairStage,
+    /// Why it could not run.
+    pub reason: String,
+}
+
+impl StageFallback {
+    fn new(stage: PairStage, reason: &str) -> Self {
+        Self {
+            stage,
+            reason: reason.to_string(),
+        }
+    }
+}
+
+impl std::fmt::Display for StageFallback {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let stage = match self.stage {
+            PairStage::Refine => "boundary refinement",
+            PairStage::MapGuided => "map step",
+        };
+        write!(
+            f,
+            "{stage} skipped, the previous stage's regions are kept: {}",
+            self.reason
+        )
+    }
 }

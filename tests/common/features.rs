@@ -93,8 +93,8 @@ pub fn spearman(a: &[f64], b: &[f64]) -> f64 {
 
 /// A small pipeline for tests: `eigenpairs` eigenpairs, `per_kind` HKS, WKS and curvature
 /// features each, 8 bands.
-pub fn small_pipeline(eigenpairs: usize, per_kind: usize) -> coseg::cache::ShapePipelineOptions {
-    let mut o = coseg::cache::ShapePipelineOptions::default();
+pub fn small_pipeline(eigenpairs: usize, per_kind: usize) -> coseg::pipeline::ShapePipelineOptions {
+    let mut o = coseg::pipeline::ShapePipelineOptions::default();
     o.spectrum.eigenpairs = eigenpairs;
     o.descriptors.hks_count = per_kind;
     o.descriptors.wks_count = per_kind;

@@ -16,7 +16,7 @@ mod text;
 
 pub use atomic::write_atomic;
 
-use super::{IN_MEMORY, MeshError, MeshReport, TriMesh};
+use super::{IN_MEMORY, MeshError, MeshReport, MeshWarning, TriMesh};
 use std::path::Path;
 
 /// A file format coseg reads and writes.
@@ -60,6 +60,8 @@ pub enum PlyVertexProperty {
 pub(crate) struct RawMesh {
     pub positions: Vec<[f64; 3]>,
     pub faces: Vec<[u32; 3]>,
+    /// What the parser skipped but the user should hear of.
+    pub warnings: Vec<MeshWarning>,
 }
 
 /// Reads a mesh, choosing the format by extension. See [`read_mesh_with_report`] to also get the
@@ -84,6 +86,9 @@ pub fn read_mesh(path: impl AsRef<Path>) -> Result<TriMesh, MeshError> {
 /// Reads a mesh (format chosen by extension) and checks it; returns the mesh and its
 /// [`MeshReport`] of warnings (degenerate triangles, duplicate faces, unreferenced vertices,
 /// non-manifold edges, boundary, several components).
+///
+/// Parser warnings come first (an OFF file's data after its declared elements,
+/// [`MeshWarning::IgnoredData`]), then the mesh's own.
 ///
 /// Errors ([`MeshError`], always naming `path`): the file cannot be read, unknown extension,
 /// wrong header, unsupported element or encoding, truncated file, malformed record, index out of
@@ -111,8 +116,10 @@ pub fn read_mesh_with_report(path: impl AsRef<Path>) -> Result<(TriMesh, MeshRep
         path: name.clone(),
         source,
     })?;
-    let mesh = read_mesh_from_bytes(&bytes, format).map_err(|e| e.with_path(&name))?;
-    let report = mesh.report();
+    let (mesh, mut parse_warnings) = parse(&bytes, format).map_err(|e| e.with_path(&name))?;
+    let mut report = mesh.report();
+    parse_warnings.append(&mut report.warnings);
+    report.warnings = parse_warnings;
     Ok((mesh, report))
 }
 
@@ -126,6 +133,11 @@ pub fn read_mesh_with_report(path: impl AsRef<Path>) -> Result<(TriMesh, MeshRep
 /// assert_eq!(mesh.faces(), &[[0, 1, 2], [0, 2, 3]]); // quad fan-triangulated
 /// ```
 pub fn read_mesh_from_bytes(bytes: &[u8], format: MeshFormat) -> Result<TriMesh, MeshError> {
+    parse(bytes, format).map(|(mesh, _)| mesh)
+}
+
+/// The mesh in `bytes` and the parser's own warnings (data it skipped).
+fn parse(bytes: &[u8], format: MeshFormat) -> Result<(TriMesh, Vec<MeshWarning>), MeshError> {
     if bytes.iter().all(|b| b.is_ascii_whitespace()) {
         return Err(MeshError::Empty {
             path: IN_MEMORY.to_string(),
@@ -138,7 +150,7 @@ pub fn read_mesh_from_bytes(bytes: &[u8], format: MeshFormat) -> Result<TriMesh,
         MeshFormat::Off => off::parse(bytes)?,
         MeshFormat::Ply => ply::parse(bytes)?,
     };
-    TriMesh::new(raw.positions, raw.faces)
+    Ok((TriMesh::new(raw.positions, raw.faces)?, raw.warnings))
 }
 
 /// Writes a mesh, choosing the format by extension, atomically (see [`write_atomic`]).

@@ -127,7 +127,11 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
         }
         fan(&poly32, &mut faces);
     }
-    Ok(RawMesh { positions, faces })
+    Ok(RawMesh {
+        positions,
+        faces,
+        warnings: Vec::new(),
+    })
 }
 
 /// Writes `mesh` as OBJ (`v` and `f` records, 1-based), coordinates in shortest round-trip

@@ -5,12 +5,13 @@
 //! the counts `V F [E]` on the header line or the next non-blank line (the edge count is
 //! ignored); one vertex per line (`x y z` then anything — normals, colours, texture coordinates —
 //! ignored); one face per line (`n i0 … in-1` then anything — a colour — ignored), 0-based
-//! indices, polygons fan-triangulated. Rejected: the `4OFF`/`nOFF` dimension prefixes and
-//! `OFF BINARY`, records fewer than the header declares (truncated file), data beyond them.
+//! indices, polygons fan-triangulated. Data after the declared records is skipped with a
+//! warning ([`MeshWarning::IgnoredData`]). Rejected: the `4OFF`/`nOFF` dimension prefixes and
+//! `OFF BINARY`, records fewer than the header declares (truncated file).
 
 use super::text::{TokenLines, coordinate, short};
 use super::{RawMesh, capacity_hint, fan, header_error, out_of_range, parse_error, truncated};
-use crate::mesh::{MeshError, TriMesh};
+use crate::mesh::{MeshError, MeshWarning, TriMesh};
 use std::io::Write;
 
 /// Parses an OFF file held in memory.
@@ -126,13 +127,21 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
         }
         fan(&poly, &mut faces);
     }
-    if let Some((l, _)) = lines.next_tokens()? {
-        return Err(parse_error(
-            Some(l),
-            format!("unexpected data after the {nv} vertices and {nf} faces the header declares"),
-        ));
+    let mut warnings = Vec::new();
+    // Other readers ignore what follows the declared elements (exporters pad files, or append
+    // edges); the mesh is complete, so this is a warning. Invalid UTF-8 there is ignored too.
+    if let Ok(Some((l, _))) = lines.next_tokens() {
+        warnings.push(MeshWarning::IgnoredData {
+            message: format!(
+                "data from line {l} on, after the {nv} vertices and {nf} faces the header declares"
+            ),
+        });
     }
-    Ok(RawMesh { positions, faces })
+    Ok(RawMesh {
+        positions,
+        faces,
+        warnings,
+    })
 }
 
 /// Checks the header keyword: `[ST][C][N]OFF`; `4OFF`/`nOFF` (other dimensions) are unsupported.

@@ -78,7 +78,11 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
         }
         super::fan(&poly, &mut faces);
     }
-    Ok(RawMesh { positions, faces })
+    Ok(RawMesh {
+        positions,
+        faces,
+        warnings: Vec::new(),
+    })
 }
 
 /// Checks that the header declares what coseg reads; returns the name of the face index list.

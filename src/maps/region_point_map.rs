@@ -2,9 +2,10 @@
 //! corresponding regions, through a functional map fitted to the region indicators and refined
 //! spectrally (ZoomOut).
 
-use super::StableError;
-use crate::spectral::zoomout::{eigenvectors, validate, zoomout_from};
-use crate::spectral::{ShapeGeometry, Spectrum, ZoomOutOptions};
+use super::MapError;
+use super::zoomout::{eigenvectors, validate, zoomout_from};
+use super::{ShapeGeometry, ZoomOutOptions};
+use crate::spectral::Spectrum;
 use faer::MatRef;
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
@@ -60,8 +61,9 @@ pub struct MapShape<'a> {
 ///
 /// ```
 /// use coseg::mesh::TriMesh;
-/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions, ZoomOutOptions};
-/// use coseg::stable::{region_point_map, MapShape, PointMapOptions};
+/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions};
+/// use coseg::maps::ZoomOutOptions;
+/// use coseg::maps::{region_point_map, MapShape, PointMapOptions};
 /// // A strip of 8 × 2 squares, cut into left and right halves.
 /// let (nx, ny) = (9u32, 3u32);
 /// let pos: Vec<[f64; 3]> = (0..nx * ny).map(|i| [(i % nx) as f64, (i / nx) as f64, 0.0]).collect();
@@ -85,20 +87,20 @@ pub fn region_point_map(
     a: &MapShape<'_>,
     b: &MapShape<'_>,
     options: &PointMapOptions,
-) -> Result<Vec<u32>, StableError> {
+) -> Result<Vec<u32>, MapError> {
     let (ga, gb) = (a.geometry(), b.geometry());
     let final_size = validate(ga, gb, &options.zoomout)?;
     for (s, name) in [(a, "A"), (b, "B")] {
         let d = s.spectrum.vertex_count();
         if s.labels.len() != d {
-            return Err(StableError::BadOption(format!(
+            return Err(MapError::InvalidOption(format!(
                 "shape {name}: {} labels for a spectrum of {d} vertices",
                 s.labels.len()
             )));
         }
     }
     if !(options.commutativity.is_finite() && options.commutativity >= 0.0) {
-        return Err(StableError::BadOption(format!(
+        return Err(MapError::InvalidOption(format!(
             "commutativity = {} must be finite and non-negative",
             options.commutativity
         )));
@@ -132,7 +134,7 @@ fn initial_map(
     phi_a: MatRef<'_, f64>,
     phi_b: MatRef<'_, f64>,
     options: &PointMapOptions,
-) -> Result<DMatrix<f64>, StableError> {
+) -> Result<DMatrix<f64>, MapError> {
     let k = options.zoomout.initial_size;
     let regions = a
         .labels
@@ -161,7 +163,7 @@ fn initial_map(
         })
         .collect();
     if shared.is_empty() {
-        return Err(StableError::BadOption(
+        return Err(MapError::InvalidOption(
             "no region is present on both shapes".into(),
         ));
     }
@@ -180,7 +182,7 @@ fn initial_map(
         let row = m
             .svd(true, true)
             .solve(&rhs, 1e-12)
-            .map_err(|e| StableError::BadOption(format!("functional map fit: {e}")))?;
+            .map_err(|e| MapError::InvalidOption(format!("functional map fit: {e}")))?;
         c.set_row(i, &row.transpose());
     }
     Ok(c)

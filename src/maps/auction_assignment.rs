@@ -2,7 +2,7 @@
 //! candidate lists (Bertsekas' auction algorithm), used by
 //! [`zoomout`](super::zoomout) to read its last point map.
 
-use super::SpectralError;
+use crate::spectral::SpectralError;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
 
@@ -80,7 +80,7 @@ pub struct Assignment {
 /// query bids above its outside option.
 ///
 /// ```
-/// use coseg::spectral::{auction_assignment, AuctionOptions, CandidateLists};
+/// use coseg::maps::{auction_assignment, AuctionOptions, CandidateLists};
 /// // Two queries whose nearest target is 0; query 1 has target 1 almost as near.
 /// let lists = CandidateLists { per_query: 2, targets: vec![0, 1, 0, 1], costs: vec![1.0, 5.0, 1.0, 1.5] };
 /// let out = auction_assignment(&lists, 2, &AuctionOptions::default()).unwrap();
@@ -111,6 +111,9 @@ pub fn auction_assignment(
     let mut map = vec![0u32; queries];
     let mut bids = 0usize;
     let epsilon = options.epsilon * scale;
+    // The cheapest slot of every target (the first of equal prices), kept up to date: a bid
+    // reads one price per candidate instead of `capacity`.
+    let mut cheapest: Vec<u32> = (0..target_count).map(|t| (t * capacity) as u32).collect();
     let mut queue: VecDeque<usize> = (0..queries).collect();
     while let Some(q) = queue.pop_front() {
         bids += 1;
@@ -119,10 +122,7 @@ pub fn auction_assignment(
         let outside = -(costs[0] + penalty);
         let (mut best, mut second, mut best_slot) = (outside, f64::NEG_INFINITY, None);
         for (&t, &cost) in targets.iter().zip(costs) {
-            let slots = t as usize * capacity..(t as usize + 1) * capacity;
-            let slot = slots
-                .min_by(|&x, &y| price[x].total_cmp(&price[y]))
-                .expect("capacity is at least 1");
+            let slot = cheapest[t as usize] as usize;
             let value = -cost - price[slot];
             if value > best {
                 second = best;
@@ -137,6 +137,10 @@ pub fn auction_assignment(
             continue;
         };
         price[slot] += best - second + epsilon;
+        let t = slot / capacity;
+        cheapest[t] = (t * capacity..(t + 1) * capacity)
+            .min_by(|&x, &y| price[x].total_cmp(&price[y]))
+            .expect("capacity is at least 1") as u32;
         let previous = std::mem::replace(&mut owner[slot], q as u32);
         map[q] = (slot / capacity) as u32;
         if previous != u32::MAX {

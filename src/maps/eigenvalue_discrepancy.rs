@@ -1,6 +1,6 @@
 //! [`eigenvalue_discrepancy`]: how far two shapes are from isometric, by their spectra.
 
-use super::{SpectralError, Spectrum};
+use crate::spectral::{SpectralError, Spectrum};
 
 /// The mean relative difference `|λ_A,i − λ_B,i| / (λ_A,i + λ_B,i)` over the eigenvalues
 /// `i = 1 … count − 1` of two unit-area spectra (the zero eigenvalue `i = 0` is skipped; a
@@ -14,7 +14,8 @@ use super::{SpectralError, Spectrum};
 ///
 /// ```
 /// use coseg::mesh::TriMesh;
-/// use coseg::spectral::{eigenvalue_discrepancy, laplace_beltrami_spectrum, SpectrumOptions};
+/// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions};
+/// use coseg::maps::eigenvalue_discrepancy;
 /// // A unit square and the same square stretched 2 : 1 (not isometric).
 /// let grid = |sx: f64| {
 ///     let n = 9u32;

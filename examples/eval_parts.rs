@@ -1,0 +1,198 @@
+//! Co-segmentation modes scored against human or generated part labels (docs/PARTS.md).
+//!
+//! ```text
+//! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N] MODE...
+//! ```
+//! `FOLDER` is either a COSEG-style set (`shapes/N.off` and `gt/N.seg`, one label per face) or a
+//! shipped family (`collections/<family>`, per-vertex labels and a manifest). Each `MODE` is
+//! `fixed:R` (`cosegment`, R equal-area regions, today's `coseg segment --regions R`), `auto`
+//! (`coseg segment --parts auto`) or `parts:N` (`--parts N`), optionally followed by
+//! `@max=M` (the upper bound, `--regions M`). COSEG sets: the area-weighted share of faces whose region id maps to their
+//! label under the best one-to-one matching of ids to labels over the whole set (each shape
+//! scaled to unit area; a face's id is the majority id of its corners). Families: purity and
+//! coverage of the grouped parts (`coseg::evaluate`).
+
+use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
+use coseg::graph::{
+    AdaptiveOptions, Cosegmentation, LoadedCollection, SegmentCollectionOptions, load_collection,
+    segment_collection,
+};
+use coseg::pipeline::ShapePipelineOptions;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+type Res<T> = Result<T, Box<dyn std::error::Error>>;
+
+/// Best one-to-one matching of region ids to labels: `conf[id][label]` is the area of faces with
+/// that id and label; returns the largest matched total (brute force over injective maps).
+fn best_matching(conf: &[Vec<f64>]) -> f64 {
+    fn go(conf: &[Vec<f64>], label: usize, used: &mut Vec<bool>) -> f64 {
+        let labels = conf.first().map_or(0, Vec::len);
+        if label == labels {
+            return 0.0;
+        }
+        let mut best = go(conf, label + 1, used);
+        for id in 0..conf.len() {
+            if !used[id] {
+                used[id] = true;
+                best = best.max(conf[id][label] + go(conf, label + 1, used));
+                used[id] = false;
+            }
+        }
+        best
+    }
+    go(conf, 0, &mut vec![false; conf.len()])
+}
+
+fn coseg_accuracy(loaded: &LoadedCollection, seg: &Cosegmentation, gt: &Path) -> Res<f64> {
+    let ids = seg.tuples.len();
+    let mut labels_of: Vec<Vec<usize>> = Vec::new();
+    let mut max_label = 0;
+    for (i, name) in seg.names.iter().enumerate() {
+        let path = gt.join(format!("{name}.seg"));
+        let text =
+            std::fs::read_to_string(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let l: Vec<usize> = text
+            .split_whitespace()
+            .map(|t| t.parse::<usize>().map(|x| x.saturating_sub(1)))
+            .collect::<Result<_, _>>()?;
+        if l.len() != loaded.meshes[i].face_count() {
+            return Err(format!(
+                "{}: {} labels for {} faces",
+                path.display(),
+                l.len(),
+                loaded.meshes[i].face_count()
+            )
+            .into());
+        }
+        max_label = max_label.max(l.iter().copied().max().unwrap_or(0));
+        labels_of.push(l);
+    }
+    let mut conf = vec![vec![0.0; max_label + 1]; ids];
+    for (i, mesh) in loaded.meshes.iter().enumerate() {
+        let region = seg.labels(i);
+        let fa = mesh.face_areas();
+        let total: f64 = fa.iter().sum();
+        for (f, tri) in mesh.faces().iter().enumerate() {
+            let r = tri.map(|v| region[v as usize]);
+            let id = if r[1] == r[2] { r[1] } else { r[0] };
+            if id >= 0 {
+                conf[id as usize][labels_of[i][f]] += fa[f] / total;
+            }
+        }
+    }
+    Ok(best_matching(&conf) / seg.names.len() as f64)
+}
+
+fn family_scores(
+    loaded: &LoadedCollection,
+    seg: &Cosegmentation,
+    folder: &Path,
+) -> Res<(f64, f64)> {
+    let truth = GroundTruth::read(folder)?;
+    let mut shapes = Vec::new();
+    for (i, mesh) in loaded.meshes.iter().enumerate() {
+        let parts = truth.grouped_labels(&seg.names[i])?;
+        shapes.push(ShapeParts::of_mesh(mesh, parts, seg.labels(i))?);
+    }
+    Ok((part_purity(&shapes)?, part_coverage(&shapes)?))
+}
+
+fn options(mode: &str, refine_rounds: usize) -> Res<SegmentCollectionOptions> {
+    let mut o = SegmentCollectionOptions::default();
+    if let Some(r) = o.refine.as_mut() {
+        r.max_rounds = refine_rounds;
+    }
+    if refine_rounds == 0 {
+        o.refine = None;
+    }
+    let (mode, max) = match mode.split_once("@max=") {
+        Some((m, x)) => (m, Some(x.parse::<usize>()?)),
+        None => (mode, None),
+    };
+    if let Some(r) = mode.strip_prefix("fixed:") {
+        o.cosegment.regions = r.parse()?;
+    } else {
+        let mut a = AdaptiveOptions::default();
+        if let Some(k) = mode.strip_prefix("parts:") {
+            a.parts = Some(k.parse()?);
+            a.max_parts = a.max_parts.max(k.parse()?);
+        } else if mode != "auto" {
+            return Err(format!("unknown mode {mode:?}").into());
+        }
+        if let Some(m) = max {
+            a.max_parts = m;
+        }
+        o.parts = Some(a);
+    }
+    Ok(o)
+}
+
+fn main() -> Res<()> {
+    let mut args = std::env::args().skip(1);
+    let folder = PathBuf::from(args.next().ok_or("FOLDER")?);
+    let mut cache = std::env::temp_dir().join("coseg-eval-cache");
+    let mut refine_rounds = SegmentCollectionOptions::DEFAULT_REFINE.max_rounds;
+    let mut modes = Vec::new();
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),
+            "--refine-rounds" => refine_rounds = args.next().ok_or("--refine-rounds N")?.parse()?,
+            _ => modes.push(a),
+        }
+    }
+    let coseg_set = folder.join("gt").is_dir();
+    let shapes = if coseg_set {
+        folder.join("shapes")
+    } else {
+        folder.clone()
+    };
+    let loaded = load_collection(
+        &shapes,
+        &ShapePipelineOptions::default(),
+        &cache,
+        |_, _, _| {},
+    )?;
+    for s in &loaded.skipped {
+        eprintln!("skipped: {}", s.error);
+    }
+    for mode in &modes {
+        let o = options(mode, refine_rounds)?;
+        let t = Instant::now();
+        let out = segment_collection(loaded.nodes.clone(), &loaded.meshes, &o)?;
+        let secs = t.elapsed().as_secs_f64();
+        let seg = &out.segmentation;
+        let sizes: Vec<String> = seg
+            .tuples
+            .iter()
+            .map(|t| {
+                let mut a = t.area_fractions.clone();
+                a.sort_by(f64::total_cmp);
+                format!("{:.0}", 100.0 * a[a.len() / 2])
+            })
+            .collect();
+        let extra = out.adaptive.as_ref().map_or(String::new(), |a| {
+            format!(
+                " leaves {} stop {:?} t {:?}",
+                a.leaves.tuples.len(),
+                a.stop,
+                a.auto.iter().map(|x| x.t).collect::<Vec<_>>()
+            )
+        });
+        let score = if coseg_set {
+            format!(
+                "accuracy {:.1} %",
+                100.0 * coseg_accuracy(&loaded, seg, &folder.join("gt"))?
+            )
+        } else {
+            let (p, c) = family_scores(&loaded, seg, &folder)?;
+            format!("purity {:.1} % coverage {:.1} %", 100.0 * p, 100.0 * c)
+        };
+        println!(
+            "{mode:>12}: {score}  parts {} (median sizes % {}){extra}  {secs:.2} s",
+            seg.tuples.len(),
+            sizes.join("/")
+        );
+    }
+    Ok(())
+}

@@ -1,0 +1,28 @@
+from os import PathLike
+from typing import Any, Iterable, List, Tuple, Union
+
+_Path = Union[str, PathLike[str]]
+
+class PrecomputeReport:
+    computed: List[str]
+    cached: List[str]
+    failed: List[Tuple[str, str]]
+    seconds: float
+    @property
+    def ok(self) -> bool: ...
+
+def mesh_files(folder: _Path) -> List[str]: ...
+def precompute(
+    paths: Union[_Path, Iterable[_Path]],
+    client: Any,
+    cache_dir: _Path,
+    *,
+    ship: str = ...,
+    retries: int = ...,
+    eigenpairs: int = ...,
+    hks: int = ...,
+    wks: int = ...,
+    curvature: int = ...,
+    bands: int = ...,
+    area_bands: bool = ...,
+) -> PrecomputeReport: ...

@@ -1,0 +1,634 @@
+//! `coseg._coseg`: the native half of the Python package. Thin over the `coseg` library: it
+//! converts numpy arrays to library types, releases the GIL while the library computes, and
+//! turns library errors into the package's exceptions (`coseg.errors`). The Python half
+//! (`coseg/__init__.py`) coerces dtypes and documents the options.
+
+mod options;
+
+use coseg::cache::CacheOutcome;
+use coseg::pipeline::{
+    ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
+};
+use coseg::graph::{SegmentCollectionOptions, ShapeNode, load_collection, segment_collection};
+use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
+use coseg::output::{
+    CollectionSummary, PairSummary, ShapeRegions, ShapeSummary, SkippedInput, write_regions,
+};
+use coseg::shape_task;
+use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
+use coseg::maps::PresetChoice;
+use coseg::stable::{PairShape, segment_pair};
+use numpy::ndarray::Array2;
+use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
+use options::Opts;
+use pyo3::prelude::*;
+use pyo3::types::{PyBytes, PyDict, PyList};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// The package exception for a library error: `FileError` (an `OSError`) when an I/O error is
+/// anywhere in its source chain, `InputError` (a `ValueError`) otherwise; the message is the
+/// library's.
+fn lib_err(e: &(dyn std::error::Error + 'static)) -> PyErr {
+    let mut io = false;
+    let mut cur: Option<&(dyn std::error::Error + 'static)> = Some(e);
+    while let Some(c) = cur {
+        io |= c.downcast_ref::<std::io::Error>().is_some();
+        cur = c.source();
+    }
+    raise(if io { "FileError" } else { "InputError" }, e.to_string())
+}
+
+/// A `coseg.errors.<class>` exception with `message`.
+fn raise(class: &str, message: String) -> PyErr {
+    Python::attach(|py| {
+        match py
+            .import("coseg.errors")
+            .and_then(|m| m.getattr(class))
+            .and_then(|c| c.call1((message.clone(),)))
+        {
+            Ok(obj) => PyErr::from_value(obj),
+            Err(e) => e,
+        }
+    })
+}
+
+fn input_err(message: impl Into<String>) -> PyErr {
+    raise("InputError", message.into())
+}
+
+trait OrRaise<T> {
+    fn or_raise(self) -> PyResult<T>;
+}
+
+impl<T, E: std::error::Error + 'static> OrRaise<T> for Result<T, E> {
+    fn or_raise(self) -> PyResult<T> {
+        self.map_err(|e| lib_err(&e))
+    }
+}
+
+/// Copies `V` (`n × 3` float64) and `F` (`m × 3` int64) into a validated mesh. `what` names the
+/// shape in errors.
+fn mesh_from(
+    v: &PyReadonlyArray2<'_, f64>,
+    f: &PyReadonlyArray2<'_, i64>,
+    what: &str,
+) -> PyResult<TriMesh> {
+    let (vs, fs) = (v.shape(), f.shape());
+    if vs[1] != 3 {
+        return Err(input_err(format!(
+            "{what}: V must be n x 3, got {} x {}",
+            vs[0], vs[1]
+        )));
+    }
+    if fs[1] != 3 {
+        return Err(input_err(format!(
+            "{what}: F must be m x 3, got {} x {}",
+            fs[0], fs[1]
+        )));
+    }
+    let va = v.as_array();
+    let positions: Vec<[f64; 3]> = va.rows().into_iter().map(|r| [r[0], r[1], r[2]]).collect();
+    let fa = f.as_array();
+    let mut faces = Vec::with_capacity(fs[0]);
+    for (i, r) in fa.rows().into_iter().enumerate() {
+        let mut tri = [0u32; 3];
+        for (t, &x) in tri.iter_mut().zip(r.iter()) {
+            *t = u32::try_from(x).map_err(|_| {
+                input_err(format!(
+                    "{what}: face {i} refers to vertex {x}, but the mesh has {} vertices",
+                    vs[0]
+                ))
+            })?;
+        }
+        faces.push(tri);
+    }
+    TriMesh::new(positions, faces).map_err(|e| input_err(e.with_path(what).to_string()))
+}
+
+fn vf<'py>(
+    py: Python<'py>,
+    mesh: &TriMesh,
+) -> (Bound<'py, PyArray2<f64>>, Bound<'py, PyArray2<i64>>) {
+    let d = mesh.vertex_count();
+    let v: Vec<f64> = mesh.positions().iter().flatten().copied().collect();
+    let f: Vec<i64> = mesh
+        .faces()
+        .iter()
+        .flatten()
+        .map(|&i| i64::from(i))
+        .collect();
+    let v = Array2::from_shape_vec((d, 3), v).expect("d x 3");
+    let f = Array2::from_shape_vec((mesh.face_count(), 3), f).expect("m x 3");
+    (v.into_pyarray(py), f.into_pyarray(py))
+}
+
+fn format_of(name: &str) -> PyResult<MeshFormat> {
+    MeshFormat::from_path(Path::new(&format!("x.{name}"))).ok_or_else(|| {
+        input_err(format!(
+            "unknown mesh format {name:?} (expected obj, off or ply)"
+        ))
+    })
+}
+
+fn key_of(hex: &str) -> PyResult<coseg::cache::ShapeKey> {
+    shape_task::parse_key(hex)
+        .ok_or_else(|| input_err(format!("{hex:?} is not a 64-digit hex key")))
+}
+
+/// JSON text to a Python object (dicts, lists, numbers, strings).
+fn json<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'py, PyAny>> {
+    let text = serde_json::to_string(value).map_err(|e| input_err(e.to_string()))?;
+    py.import("json")?.call_method1("loads", (text,))
+}
+
+/// Library defaults of every option the package exposes, by keyword.
+#[pyfunction]
+fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    options::defaults(py)
+}
+
+/// Reads a mesh file (.obj, .off, .ply): `(V, F, warnings)`.
+#[pyfunction]
+fn read_mesh<'py>(py: Python<'py>, path: PathBuf) -> PyResult<Bound<'py, PyAny>> {
+    let (mesh, report) = py.detach(|| read_mesh_with_report(&path)).or_raise()?;
+    let (v, f) = vf(py, &mesh);
+    let warnings: Vec<String> = report
+        .warnings
+        .iter()
+        .map(|w| format!("{}: {w}", path.display()))
+        .collect();
+    Ok((v, f, warnings).into_pyobject(py)?.into_any())
+}
+
+/// `(eigenvalues (k,), eigenvectors (n, k), vertex_areas (n,))` of the unit-area mesh.
+#[pyfunction]
+fn spectrum<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'py, f64>,
+    f: PyReadonlyArray2<'py, i64>,
+    k: usize,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mesh = mesh_from(&v, &f, "mesh")?;
+    let s = py
+        .detach(|| laplace_beltrami_spectrum(&mesh, &SpectrumOptions::with_eigenpairs(k)))
+        .or_raise()?;
+    let (d, k) = (s.vertex_count(), s.len());
+    // Column-major d x k is row-major k x d, transposed.
+    let vecs = Array2::from_shape_vec((k, d), s.eigenvectors)
+        .expect("k x d")
+        .reversed_axes();
+    let out = (
+        PyArray1::from_vec(py, s.eigenvalues),
+        vecs.into_pyarray(py),
+        PyArray1::from_vec(py, s.vertex_areas),
+    );
+    Ok(out.into_pyobject(py)?.into_any())
+}
+
+/// `(names, matrix (n, N))` of the descriptor table.
+#[pyfunction]
+#[pyo3(signature = (v, f, options=None))]
+fn features<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'py, f64>,
+    f: PyReadonlyArray2<'py, i64>,
+    options: Option<Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut o = Opts::new(options);
+    let pipe = o.pipeline()?;
+    o.finish()?;
+    let mesh = mesh_from(&v, &f, "mesh")?;
+    let data = py.detach(|| compute_shape_data(&mesh, &pipe)).or_raise()?;
+    let desc = data.descriptors;
+    let (n, d) = (desc.feature_count(), desc.vertices);
+    let names = desc.names();
+    let m = Array2::from_shape_vec((n, d), desc.values)
+        .expect("N x d")
+        .reversed_axes();
+    Ok((names, m.into_pyarray(py)).into_pyobject(py)?.into_any())
+}
+
+/// The band table, `(n, N)` uint8 labels in `0..bands`.
+#[pyfunction]
+#[pyo3(signature = (v, f, options=None))]
+fn band_table<'py>(
+    py: Python<'py>,
+    v: PyReadonlyArray2<'py, f64>,
+    f: PyReadonlyArray2<'py, i64>,
+    options: Option<Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyArray2<u8>>> {
+    let mut o = Opts::new(options);
+    let pipe = o.pipeline()?;
+    o.finish()?;
+    let mesh = mesh_from(&v, &f, "mesh")?;
+    let data = py.detach(|| compute_shape_data(&mesh, &pipe)).or_raise()?;
+    let t = data.bands;
+    Ok(Array2::from_shape_vec((t.vertices, t.features), t.labels)
+        .expect("d x N")
+        .into_pyarray(py))
+}
+
+/// `(key_hex, vertices)` of mesh file bytes under the pipeline options.
+#[pyfunction]
+#[pyo3(signature = (mesh_bytes, format, options=None))]
+fn shape_key<'py>(
+    py: Python<'py>,
+    mesh_bytes: &[u8],
+    format: String,
+    options: Option<Bound<'py, PyDict>>,
+) -> PyResult<(String, usize)> {
+    let mut o = Opts::new(options);
+    let pipe = o.pipeline()?;
+    o.finish()?;
+    let format = format_of(&format)?;
+    let (key, d) = py
+        .detach(|| shape_task::shape_key_of_bytes(mesh_bytes, format, &pipe))
+        .or_raise()?;
+    Ok((key.to_hex(), d))
+}
+
+/// The per-shape task: `(key_hex, vertices, entry bytes, bands entry bytes)`.
+#[pyfunction]
+#[pyo3(signature = (mesh_bytes, format, options=None))]
+fn shape_entry<'py>(
+    py: Python<'py>,
+    mesh_bytes: &[u8],
+    format: String,
+    options: Option<Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyAny>> {
+    let mut o = Opts::new(options);
+    let pipe = o.pipeline()?;
+    o.finish()?;
+    let format = format_of(&format)?;
+    let e = py
+        .detach(|| shape_task::compute_shape_entry(mesh_bytes, format, &pipe))
+        .or_raise()?;
+    let out = (
+        e.key.to_hex(),
+        e.vertices,
+        PyBytes::new(py, &e.entry),
+        PyBytes::new(py, &e.bands_entry),
+    );
+    Ok(out.into_pyobject(py)?.into_any())
+}
+
+/// Verifies and atomically writes both entries; returns their paths.
+#[pyfunction]
+fn store_entry(
+    py: Python<'_>,
+    cache_dir: PathBuf,
+    key: String,
+    vertices: usize,
+    entry: &[u8],
+    bands_entry: &[u8],
+) -> PyResult<(PathBuf, PathBuf)> {
+    let key = key_of(&key)?;
+    let [a, b] = py
+        .detach(|| shape_task::store_shape_entry(&cache_dir, &key, vertices, entry, bands_entry))
+        .or_raise()?;
+    Ok((a, b))
+}
+
+/// True when both entries of `key` in `cache_dir` verify.
+#[pyfunction]
+fn entry_is_valid(
+    py: Python<'_>,
+    cache_dir: PathBuf,
+    key: String,
+    vertices: usize,
+) -> PyResult<bool> {
+    let key = key_of(&key)?;
+    Ok(py.detach(|| shape_task::entry_is_valid(&cache_dir, &key, vertices)))
+}
+
+/// A shape handed to `pair`/`segment`: its mesh and display name.
+struct Shape {
+    name: String,
+    file: String,
+    mesh: TriMesh,
+}
+
+fn shapes_from(list: &Bound<'_, PyList>, names: Option<Vec<String>>) -> PyResult<Vec<Shape>> {
+    let mut out = Vec::with_capacity(list.len());
+    for (i, item) in list.iter().enumerate() {
+        let (v, f): (PyReadonlyArray2<f64>, PyReadonlyArray2<i64>) = item.extract()?;
+        let name = names
+            .as_ref()
+            .and_then(|n| n.get(i).cloned())
+            .unwrap_or_else(|| format!("shape{i:03}"));
+        let mesh = mesh_from(&v, &f, &format!("shape {i} ({name})"))?;
+        out.push(Shape {
+            file: name.clone(),
+            name,
+            mesh,
+        });
+    }
+    Ok(out)
+}
+
+/// Pair stage: `{"labels_a", "labels_b", "summary", "written"}`.
+#[pyfunction]
+#[pyo3(signature = (shapes, names=None, options=None))]
+fn pair<'py>(
+    py: Python<'py>,
+    shapes: Bound<'py, PyList>,
+    names: Option<Vec<String>>,
+    options: Option<Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut o = Opts::new(options);
+    let pipe = o.pipeline()?;
+    let cache: Option<PathBuf> = o.take("cache_dir")?;
+    let out_dir: Option<PathBuf> = o.take("out")?;
+    let pair_opts = o.pair()?;
+    o.finish()?;
+    let mut shapes = shapes_from(&shapes, names)?;
+    if shapes.len() != 2 {
+        return Err(input_err(format!(
+            "pair needs 2 shapes, got {}",
+            shapes.len()
+        )));
+    }
+    if shapes[0].name == shapes[1].name {
+        shapes[0].name = format!("{}_a", shapes[0].name);
+    }
+    let (regions, summary) = py
+        .detach(|| -> Result<_, Box<dyn std::error::Error + Send + Sync>> {
+            let mut data = Vec::new();
+            for s in &shapes {
+                let d = match &cache {
+                    Some(dir) => load_or_compute(&s.mesh, &pipe, dir).map(|r| r.data),
+                    None => compute_shape_data(&s.mesh, &pipe),
+                }
+                .map_err(|e| format!("{}: {e}", s.file))?;
+                data.push(d);
+            }
+            let (da, db) = (&data[0], &data[1]);
+            let (options, choice, chosen) = pair_opts.resolve(&da.spectrum, &db.spectrum)?;
+            let t = std::time::Instant::now();
+            let regions = segment_pair(
+                PairShape {
+                    mesh: &shapes[0].mesh,
+                    spectrum: &da.spectrum,
+                    bands: &da.bands,
+                    descriptors: Some(&da.descriptors.values),
+                },
+                PairShape {
+                    mesh: &shapes[1].mesh,
+                    spectrum: &db.spectrum,
+                    bands: &db.bands,
+                    descriptors: Some(&db.descriptors.values),
+                },
+                &options,
+            )?
+            .regions;
+            let seconds = t.elapsed().as_secs_f64();
+            let summary_shape = |s: &Shape| ShapeSummary {
+                name: s.name.clone(),
+                file: s.file.clone(),
+                vertices: s.mesh.vertex_count(),
+                area: s.mesh.total_area(),
+            };
+            let summary = PairSummary::new(
+                [summary_shape(&shapes[0]), summary_shape(&shapes[1])],
+                &regions,
+                &options.regions,
+                None,
+                seconds,
+            )
+            .with_refine(options.refine)
+            .with_map_guided(options.map_guided.clone())
+            .with_map_preset(options.map_guided.as_ref().map(|_| PresetChoice {
+                preset: chosen,
+                discrepancy: choice.discrepancy,
+            }));
+            Ok((regions, summary))
+        })
+        .map_err(|e| input_err(e.to_string()))?;
+    let (la, lb) = (regions.labels_a(), regions.labels_b());
+    let written = match &out_dir {
+        Some(dir) => {
+            let list = [
+                ShapeRegions {
+                    name: &shapes[0].name,
+                    mesh: &shapes[0].mesh,
+                    regions: &la,
+                },
+                ShapeRegions {
+                    name: &shapes[1].name,
+                    mesh: &shapes[1].mesh,
+                    regions: &lb,
+                },
+            ];
+            py.detach(|| write_regions(dir, &list, &summary))
+                .or_raise()?
+        }
+        None => Vec::new(),
+    };
+    let d = PyDict::new(py);
+    d.set_item("labels_a", PyArray1::from_vec(py, la))?;
+    d.set_item("labels_b", PyArray1::from_vec(py, lb))?;
+    d.set_item("summary", json(py, &summary)?)?;
+    d.set_item("written", written)?;
+    Ok(d)
+}
+
+/// What `segment` works on: the loaded shapes, where their data came from, and notes.
+struct Loaded {
+    names: Vec<String>,
+    files: Vec<String>,
+    meshes: Vec<TriMesh>,
+    nodes: Vec<ShapeNode>,
+    skipped: Vec<SkippedInput>,
+    warnings: Vec<String>,
+    /// Per shape: `"hit"`, `"miss"` or `"recomputed"` (cache), `"computed"` (no cache).
+    outcomes: Vec<&'static str>,
+}
+
+fn outcome(o: &CacheOutcome) -> &'static str {
+    match o {
+        CacheOutcome::Hit => "hit",
+        CacheOutcome::Miss => "miss",
+        CacheOutcome::Recomputed { .. } => "recomputed",
+    }
+}
+
+/// Shapes given as arrays: the per-shape stage on rayon's pool (through the cache if given).
+fn load_arrays(
+    shapes: Vec<Shape>,
+    pipe: &ShapePipelineOptions,
+    cache: Option<&Path>,
+) -> Result<Loaded, String> {
+    let results: Vec<_> = shapes
+        .par_iter()
+        .map(
+            |s| -> Result<(ShapeNode, Vec<String>, &'static str), String> {
+                let (bands, areas, warnings, how) = match cache {
+                    Some(dir) => {
+                        let r = load_or_compute_bands(&s.mesh, pipe, dir)
+                            .map_err(|e| format!("{}: {e}", s.name))?;
+                        (
+                            r.data.bands,
+                            r.data.vertex_areas,
+                            r.warnings,
+                            outcome(&r.outcome),
+                        )
+                    }
+                    None => {
+                        let d = compute_shape_data(&s.mesh, pipe)
+                            .map_err(|e| format!("{}: {e}", s.name))?;
+                        (d.bands, d.descriptors.vertex_areas, Vec::new(), "computed")
+                    }
+                };
+                let node = ShapeNode::new(s.name.clone(), bands, &areas)
+                    .map_err(|e| format!("{}: {e}", s.name))?;
+                Ok((node, warnings, how))
+            },
+        )
+        .collect();
+    let mut out = Loaded {
+        names: Vec::new(),
+        files: Vec::new(),
+        meshes: Vec::new(),
+        nodes: Vec::new(),
+        skipped: Vec::new(),
+        warnings: Vec::new(),
+        outcomes: Vec::new(),
+    };
+    for (s, r) in shapes.into_iter().zip(results) {
+        let (node, warnings, how) = r?;
+        out.warnings.extend(warnings);
+        out.outcomes.push(how);
+        out.names.push(s.name);
+        out.files.push(s.file);
+        out.meshes.push(s.mesh);
+        out.nodes.push(node);
+    }
+    Ok(out)
+}
+
+/// A folder, read exactly as `coseg segment FOLDER` reads it.
+fn load_folder(folder: &Path, pipe: &ShapePipelineOptions, cache: &Path) -> Result<Loaded, String> {
+    let c = load_collection(folder, pipe, cache, |_, _, _| {})
+        .map_err(|e| format!("reading {}: {e}", folder.display()))?;
+    Ok(Loaded {
+        names: c.nodes.iter().map(|n| n.name.clone()).collect(),
+        files: c.paths.iter().map(|p| p.display().to_string()).collect(),
+        meshes: c.meshes,
+        nodes: c.nodes,
+        skipped: c
+            .skipped
+            .iter()
+            .map(|s| SkippedInput {
+                path: s.path.display().to_string(),
+                error: s.error.clone(),
+            })
+            .collect(),
+        warnings: c.warnings,
+        outcomes: c.outcomes.iter().map(outcome).collect(),
+    })
+}
+
+/// Collection stage: `{"names", "labels", "summary", "skipped", "warnings", "written"}`.
+#[pyfunction]
+#[pyo3(signature = (shapes, names=None, options=None))]
+fn segment<'py>(
+    py: Python<'py>,
+    shapes: Bound<'py, PyAny>,
+    names: Option<Vec<String>>,
+    options: Option<Bound<'py, PyDict>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut o = Opts::new(options);
+    let pipe = o.pipeline()?;
+    let cache: Option<PathBuf> = o.take("cache_dir")?;
+    let out_dir: Option<PathBuf> = o.take("out")?;
+    let seg_opts: SegmentCollectionOptions = o.segment()?;
+    o.finish()?;
+    let loaded = if let Ok(list) = shapes.cast::<PyList>() {
+        let list = shapes_from(list, names)?;
+        if list.len() < 2 {
+            return Err(input_err(format!(
+                "co-segmentation needs at least 2 readable shapes, got {}",
+                list.len()
+            )));
+        }
+        py.detach(|| load_arrays(list, &pipe, cache.as_deref()))
+    } else {
+        let folder: PathBuf = shapes.extract()?;
+        let cache = cache.clone().unwrap_or_else(|| match &out_dir {
+            Some(o) => o.join(".cache"),
+            None => folder.join(".cache"),
+        });
+        py.detach(|| load_folder(&folder, &pipe, &cache))
+    }
+    .map_err(input_err)?;
+    if loaded.nodes.len() < 2 {
+        return Err(input_err(format!(
+            "co-segmentation needs at least 2 readable shapes, got {}",
+            loaded.nodes.len()
+        )));
+    }
+    let Loaded {
+        names,
+        files,
+        meshes,
+        nodes,
+        skipped,
+        warnings,
+        outcomes,
+    } = loaded;
+    let result = py
+        .detach(|| segment_collection(nodes, &meshes, &seg_opts))
+        .or_raise()?;
+    let summary = CollectionSummary::new(&result, &files, &seg_opts, skipped.clone());
+    let seg = &result.segmentation;
+    let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
+    let written = match &out_dir {
+        Some(dir) => {
+            let list: Vec<ShapeRegions> = seg
+                .names
+                .iter()
+                .zip(&meshes)
+                .zip(&labels)
+                .map(|((name, mesh), regions)| ShapeRegions {
+                    name,
+                    mesh,
+                    regions,
+                })
+                .collect();
+            py.detach(|| write_regions(dir, &list, &summary))
+                .or_raise()?
+        }
+        None => Vec::new(),
+    };
+    let d = PyDict::new(py);
+    d.set_item("names", names)?;
+    let arrays: Vec<Bound<PyArray1<i32>>> = labels
+        .into_iter()
+        .map(|l| PyArray1::from_vec(py, l))
+        .collect();
+    d.set_item("labels", arrays)?;
+    d.set_item("summary", json(py, &summary)?)?;
+    d.set_item("skipped", json(py, &skipped)?)?;
+    d.set_item("warnings", warnings)?;
+    d.set_item("outcomes", outcomes)?;
+    d.set_item("written", written)?;
+    Ok(d)
+}
+
+#[pymodule]
+fn _coseg(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_function(wrap_pyfunction!(defaults, m)?)?;
+    m.add_function(wrap_pyfunction!(read_mesh, m)?)?;
+    m.add_function(wrap_pyfunction!(spectrum, m)?)?;
+    m.add_function(wrap_pyfunction!(features, m)?)?;
+    m.add_function(wrap_pyfunction!(band_table, m)?)?;
+    m.add_function(wrap_pyfunction!(shape_key, m)?)?;
+    m.add_function(wrap_pyfunction!(shape_entry, m)?)?;
+    m.add_function(wrap_pyfunction!(store_entry, m)?)?;
+    m.add_function(wrap_pyfunction!(entry_is_valid, m)?)?;
+    m.add_function(wrap_pyfunction!(pair, m)?)?;
+    m.add_function(wrap_pyfunction!(segment, m)?)?;
+    m.add("FORMAT_VERSION", coseg::cache::FORMAT_VERSION)?;
+    Ok(())
+}

@@ -1,0 +1,287 @@
+//! Keyword options: a dict from the Python half, read key by key into the library's option
+//! structs (starting from their `Default`s, so an absent key keeps the library's default), with
+//! unknown keys rejected so that a typo never passes silently.
+
+use coseg::bands::BandWeighting;
+use coseg::pipeline::ShapePipelineOptions;
+use coseg::graph::{CosegmentOptions, GraphOptions, SegmentCollectionOptions};
+use coseg::maps::{MapPreset, PointMapOptions, PresetChoice, ZoomOutOptions, map_preset};
+use coseg::spectral::Spectrum;
+use coseg::stable::{
+    Algorithm, AreaReference, Init, MapGuidedOptions, RefineOptions, SegmentPairOptions,
+    StableError, StableRegionsOptions, TSearch, Threshold,
+};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+/// The options dict, consumed key by key.
+pub struct Opts<'py>(Option<Bound<'py, PyDict>>);
+
+impl<'py> Opts<'py> {
+    pub fn new(d: Option<Bound<'py, PyDict>>) -> Self {
+        Self(d)
+    }
+
+    /// Removes `key` and converts it; `None` when absent or `None`.
+    pub fn take<T: for<'a> FromPyObject<'a, 'py>>(&mut self, key: &str) -> PyResult<Option<T>> {
+        let Some(d) = &self.0 else { return Ok(None) };
+        let Some(v) = d.get_item(key)? else {
+            return Ok(None);
+        };
+        d.del_item(key)?;
+        if v.is_none() {
+            return Ok(None);
+        }
+        v.extract::<T>().map(Some).map_err(|e| {
+            let e: PyErr = e.into();
+            super::input_err(format!("option {key}: {e}"))
+        })
+    }
+
+    /// Errors on any key not consumed.
+    pub fn finish(self) -> PyResult<()> {
+        match &self.0 {
+            Some(d) if !d.is_empty() => {
+                let keys: Vec<String> = d.keys().iter().map(|k| k.to_string()).collect();
+                Err(pyo3::exceptions::PyTypeError::new_err(format!(
+                    "unknown option(s): {}",
+                    keys.join(", ")
+                )))
+            }
+            _ => Ok(()),
+        }
+    }
+
+    /// `eigenpairs`, `hks`, `wks`, `curvature`, `bands`, `area_bands`.
+    pub fn pipeline(&mut self) -> PyResult<ShapePipelineOptions> {
+        let mut p = ShapePipelineOptions::default();
+        if let Some(k) = self.take("eigenpairs")? {
+            p.spectrum.eigenpairs = k;
+        }
+        if let Some(k) = self.take("hks")? {
+            p.descriptors.hks_count = k;
+        }
+        if let Some(k) = self.take("wks")? {
+            p.descriptors.wks_count = k;
+        }
+        if let Some(k) = self.take("curvature")? {
+            p.descriptors.curvature_count = k;
+        }
+        if let Some(k) = self.take("bands")? {
+            p.bands.bands = k;
+        }
+        if self.take::<bool>("area_bands")? == Some(true) {
+            p.bands.weighting = BandWeighting::Area;
+        }
+        Ok(p)
+    }
+
+    /// The collection stage's options, as `coseg segment` sets them.
+    pub fn segment(&mut self) -> PyResult<SegmentCollectionOptions> {
+        let d = SegmentCollectionOptions::default();
+        let mut graph = GraphOptions::default();
+        let mut cos = CosegmentOptions::default();
+        if let Some(v) = self.take("regions")? {
+            cos.regions = v;
+        }
+        cos.area_fraction = self.take("area_fraction")?;
+        cos.seed = self.take("seed")?;
+        if let Some(v) = self.take("complete_limit")? {
+            graph.complete_limit = v;
+        }
+        if let Some(v) = self.take("neighbours")? {
+            graph.neighbours = v;
+        }
+        let base = d
+            .refine
+            .clone()
+            .unwrap_or(SegmentCollectionOptions::DEFAULT_REFINE);
+        let rounds = self.take("refine_rounds")?.unwrap_or(base.max_rounds);
+        let time = self.take("smoothing_time")?.unwrap_or(base.smoothing_time);
+        Ok(SegmentCollectionOptions {
+            graph,
+            cosegment: cos,
+            refine: (rounds > 0).then_some(RefineOptions {
+                max_rounds: rounds,
+                smoothing_time: time,
+            }),
+        })
+    }
+
+    /// The pair stage's options, as `coseg pair` sets them.
+    pub fn pair(&mut self) -> PyResult<PairOpts> {
+        let mut r = StableRegionsOptions::default();
+        if let Some(a) = self.take::<String>("algorithm")? {
+            r.algorithm = match a.as_str() {
+                "fixed" => Algorithm::Fixed,
+                "auto" => Algorithm::Auto,
+                _ => return Err(bad("algorithm", &a, "fixed, auto")),
+            };
+        }
+        if let Some(v) = self.take("pairs")? {
+            r.pairs = v;
+        }
+        if let Some(a) = self.take::<f64>("alpha")? {
+            r.p = Threshold::AreaFraction(a);
+            r.q = Threshold::AreaFraction(a);
+        }
+        if self.take::<bool>("alpha_of_remaining")? == Some(true) {
+            r.area_reference = AreaReference::Remaining;
+        }
+        if let Some(v) = self.take("delta_t")? {
+            r.delta_t = v;
+        }
+        if let Some(v) = self.take("t_max")? {
+            r.t_max = v;
+        }
+        if self.take::<bool>("linear_t")? == Some(true) {
+            r.t_search = TSearch::Linear;
+        }
+        if let Some(a) = self.take::<String>("init")? {
+            r.init = match a.as_str() {
+                "extreme" => Init::Extreme,
+                "random" => Init::Random,
+                _ => return Err(bad("init", &a, "extreme, random")),
+            };
+        }
+        if let Some(v) = self.take("seed")? {
+            r.seed = v;
+        }
+        if let Some(v) = self.take("max_iterations")? {
+            r.max_iterations = v;
+        }
+        let base = RefineOptions::default();
+        let rounds = self.take("refine_rounds")?.unwrap_or(base.max_rounds);
+        let time = self.take("smoothing_time")?.unwrap_or(base.smoothing_time);
+        let preset = match self.take::<String>("map_preset")?.as_deref() {
+            None | Some("auto") => None,
+            Some("general") => Some(MapPreset::General),
+            Some("near-isometric") | Some("near_isometric") => Some(MapPreset::NearIsometric),
+            Some(other) => return Err(bad("map_preset", other, "auto, general, near-isometric")),
+        };
+        Ok(PairOpts {
+            regions: r,
+            refine: (rounds > 0).then_some(RefineOptions {
+                max_rounds: rounds,
+                smoothing_time: time,
+            }),
+            preset,
+            map_weight: self.take("map_weight")?,
+            map_size: self
+                .take("map_size")?
+                .unwrap_or(ZoomOutOptions::default().final_size),
+            map_smoothing_time: self
+                .take("map_smoothing_time")?
+                .unwrap_or(MapGuidedOptions::default().smoothing_time),
+        })
+    }
+}
+
+fn bad(key: &str, value: &str, allowed: &str) -> PyErr {
+    super::input_err(format!("option {key}: {value:?} is not one of {allowed}"))
+}
+
+/// The pair options before the map preset is chosen from the two spectra.
+#[derive(Clone)]
+pub struct PairOpts {
+    regions: StableRegionsOptions,
+    refine: Option<RefineOptions>,
+    preset: Option<MapPreset>,
+    map_weight: Option<f64>,
+    map_size: usize,
+    map_smoothing_time: f64,
+}
+
+impl PairOpts {
+    /// The full options for the pair with these spectra, the automatic choice and the preset
+    /// used (as `coseg pair` resolves `--map-preset`).
+    pub fn resolve(
+        &self,
+        a: &Spectrum,
+        b: &Spectrum,
+    ) -> Result<(SegmentPairOptions, PresetChoice, MapPreset), StableError> {
+        let choice = map_preset(a, b)?;
+        let chosen = self.preset.unwrap_or(choice.preset);
+        let preset = chosen.options();
+        let map_weight = self.map_weight.unwrap_or(preset.map_weight);
+        let map_guided = (map_weight > 0.0).then(|| MapGuidedOptions {
+            point_map: PointMapOptions {
+                zoomout: ZoomOutOptions {
+                    final_size: self.map_size,
+                    ..preset.point_map.zoomout.clone()
+                },
+                ..preset.point_map.clone()
+            },
+            map_weight,
+            smoothing_time: self.map_smoothing_time,
+        });
+        let options = SegmentPairOptions {
+            regions: self.regions.clone(),
+            refine: self.refine.clone(),
+            map_guided,
+        };
+        Ok((options, choice, chosen))
+    }
+}
+
+/// Library defaults of every keyword the package exposes.
+pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+    let d = PyDict::new(py);
+    let p = ShapePipelineOptions::default();
+    d.set_item("eigenpairs", p.spectrum.eigenpairs)?;
+    d.set_item("hks", p.descriptors.hks_count)?;
+    d.set_item("wks", p.descriptors.wks_count)?;
+    d.set_item("curvature", p.descriptors.curvature_count)?;
+    d.set_item("bands", p.bands.bands)?;
+    d.set_item("area_bands", p.bands.weighting == BandWeighting::Area)?;
+    let s = SegmentCollectionOptions::default();
+    let refine = s
+        .refine
+        .clone()
+        .unwrap_or(SegmentCollectionOptions::DEFAULT_REFINE);
+    d.set_item("regions", s.cosegment.regions)?;
+    d.set_item("area_fraction", s.cosegment.area_fraction)?;
+    d.set_item("segment_seed", s.cosegment.seed)?;
+    d.set_item("complete_limit", s.graph.complete_limit)?;
+    d.set_item("neighbours", s.graph.neighbours)?;
+    d.set_item("segment_refine_rounds", refine.max_rounds)?;
+    d.set_item("segment_smoothing_time", refine.smoothing_time)?;
+    let r = StableRegionsOptions::default();
+    d.set_item(
+        "algorithm",
+        match r.algorithm {
+            Algorithm::Fixed => "fixed",
+            Algorithm::Auto => "auto",
+        },
+    )?;
+    d.set_item("pairs", r.pairs)?;
+    if let Threshold::AreaFraction(a) = r.p {
+        d.set_item("alpha", a)?;
+    }
+    d.set_item(
+        "alpha_of_remaining",
+        r.area_reference == AreaReference::Remaining,
+    )?;
+    d.set_item("delta_t", r.delta_t)?;
+    d.set_item("t_max", r.t_max)?;
+    d.set_item("linear_t", r.t_search == TSearch::Linear)?;
+    d.set_item(
+        "init",
+        match r.init {
+            Init::Extreme => "extreme",
+            Init::Random => "random",
+        },
+    )?;
+    d.set_item("pair_seed", r.seed)?;
+    d.set_item("max_iterations", r.max_iterations)?;
+    let pr = RefineOptions::default();
+    d.set_item("pair_refine_rounds", pr.max_rounds)?;
+    d.set_item("pair_smoothing_time", pr.smoothing_time)?;
+    d.set_item("map_preset", "auto")?;
+    d.set_item("map_size", ZoomOutOptions::default().final_size)?;
+    d.set_item(
+        "map_smoothing_time",
+        MapGuidedOptions::default().smoothing_time,
+    )?;
+    Ok(d)
+}

@@ -1,0 +1,81 @@
+"""The package gives the CLI's results: region files byte for byte, cache entries byte for byte."""
+
+import json
+import subprocess
+from pathlib import Path
+
+import numpy as np
+
+import coseg
+from conftest import COLLECTIONS, SMALL, cli_flags
+
+
+def region_files(d):
+    return sorted(p.name for p in Path(d).iterdir() if ".regions." in p.name)
+
+
+def assert_same_outputs(a, b):
+    names = region_files(a)
+    assert names and names == region_files(b)
+    for n in names:
+        assert (Path(a) / n).read_bytes() == (Path(b) / n).read_bytes(), n
+    sa, sb = (json.loads((Path(d) / "summary.json").read_text()) for d in (a, b))
+    for s in (sa, sb):  # input paths are spelled differently; everything else must agree
+        for shape in s.get("shapes", []):
+            shape.pop("file", None)
+    assert sa == sb
+
+
+def test_segment_matches_the_cli(coseg_bin, chairs, tmp_path):
+    cli_out, py_out = tmp_path / "cli", tmp_path / "py"
+    subprocess.run(
+        [coseg_bin, "segment", str(chairs), "-o", str(cli_out), "--regions", "4", *cli_flags()],
+        check=True,
+        capture_output=True,
+    )
+    r = coseg.segment(chairs, out=py_out, regions=4, **SMALL)
+    assert_same_outputs(cli_out, py_out)
+    # The CLI's cache entries are the pure task's bytes: same content key, same content.
+    for obj in sorted(chairs.glob("*.obj")):
+        e = coseg.shape_entry(obj.read_bytes(), "obj", **SMALL)
+        assert (cli_out / ".cache" / f"{e.key}.coseg-shape").read_bytes() == e.entry
+        assert (cli_out / ".cache" / f"{e.key}.coseg-bands").read_bytes() == e.bands_entry
+    # The folder form read the CLI's entries? No: it used its own <out>/.cache. Both agree.
+    assert all(o == "miss" for o in r["outcomes"])
+    # Arrays in give the same labels as the folder.
+    shapes = [coseg.read_mesh(p) for p in sorted(chairs.glob("*.obj"))]
+    names = [p.stem for p in sorted(chairs.glob("*.obj"))]
+    r2 = coseg.segment(shapes, names=names, regions=4, **SMALL)
+    assert r2["names"] == r["names"] == names
+    for a, b in zip(r["labels"], r2["labels"]):
+        assert a.dtype == np.int32 and np.array_equal(a, b)
+    # Labels are the region files' content.
+    for name, labels in zip(r["names"], r["labels"]):
+        txt = (py_out / f"{name}.regions.txt").read_text().split()
+        assert np.array_equal(np.array(txt, dtype=np.int32), labels)
+
+
+def test_pair_matches_the_cli(coseg_bin, tmp_path):
+    a = COLLECTIONS / "goblets" / "goblets_00.obj"
+    b = COLLECTIONS / "goblets" / "goblets_01.obj"
+    cli_out, py_out = tmp_path / "cli", tmp_path / "py"
+    subprocess.run(
+        [coseg_bin, "pair", str(a), str(b), "-o", str(cli_out), "--pairs", "5", *cli_flags()],
+        check=True,
+        capture_output=True,
+    )
+    r = coseg.pair(a, b, out=py_out, pairs=5, **SMALL)
+    names = region_files(cli_out)
+    assert names == region_files(py_out) == ["goblets_00.regions.ply", "goblets_00.regions.txt",
+                                              "goblets_01.regions.ply", "goblets_01.regions.txt"]
+    for n in names:
+        assert (cli_out / n).read_bytes() == (py_out / n).read_bytes(), n
+    sa = json.loads((cli_out / "summary.json").read_text())
+    sb = r["summary"]
+    for s in (sa, sb):
+        s.pop("seconds", None)
+        for shape in s["shapes"]:
+            shape.pop("file")
+    assert sa == sb
+    assert r["labels_a"].shape == (coseg.read_mesh(a)[0].shape[0],)
+    assert len(np.unique(r["labels_b"])) <= 5

@@ -1,0 +1,281 @@
+//! What the per-shape pipeline computes ([`ShapeData`], [`ShapeBands`]), its options and how
+//! it is computed from a mesh.
+
+use crate::bands::{BandError, BandOptions, BandTable, band_table};
+use crate::cache::{EntryKind, ShapeKey, decode_entry, encode_entry, entry_key};
+use crate::features::{DescriptorOptions, Descriptors, FeatureError, descriptors};
+use crate::mesh::{MeshError, TriMesh};
+use crate::spectral::{
+    SpectralError, Spectrum, SpectrumOptions, available_eigenpairs, laplace_beltrami_spectrum,
+};
+use thiserror::Error;
+
+/// Errors of the per-shape pipeline and its cache.
+#[derive(Debug, Error)]
+pub enum PipelineError {
+    /// The mesh file could not be read (the message names the file).
+    #[error(transparent)]
+    Mesh(#[from] MeshError),
+    /// The spectrum could not be computed.
+    #[error(transparent)]
+    Spectral(#[from] SpectralError),
+    /// The descriptors could not be computed.
+    #[error(transparent)]
+    Features(#[from] FeatureError),
+    /// The band table could not be computed.
+    #[error(transparent)]
+    Bands(#[from] BandError),
+    /// The cache directory could not be created.
+    #[error("{path}: {source}")]
+    Io {
+        /// The directory or file concerned.
+        path: String,
+        /// The underlying I/O error.
+        #[source]
+        source: std::io::Error,
+    },
+}
+
+/// Every option of the per-shape stages; all of it goes into the cache key.
+#[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ShapePipelineOptions {
+    /// Eigenpairs (default: 200).
+    pub spectrum: SpectrumOptions,
+    /// Features (default: 100 HKS + 100 WKS + 100 mean curvature).
+    pub descriptors: DescriptorOptions,
+    /// Bands (default: `K = 20`, equal counts).
+    pub bands: BandOptions,
+}
+
+/// Everything coseg computes once per shape.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ShapeData {
+    /// The key these data were computed for (see [`shape_key`]).
+    pub key: ShapeKey,
+    /// Number of vertices `d` of the mesh.
+    pub vertices: usize,
+    /// Unit-area Laplace–Beltrami spectrum.
+    pub spectrum: Spectrum,
+    /// `N × d` feature table.
+    pub descriptors: Descriptors,
+    /// `d × N` band labels.
+    pub bands: BandTable,
+}
+
+/// What the collection stage needs of a shape: its band table and vertex areas (the compact
+/// cache entry of [`super::load_or_compute_bands`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ShapeBands {
+    /// The key these data were computed for (see [`shape_key`]).
+    pub key: ShapeKey,
+    /// `d × N` band labels.
+    pub bands: BandTable,
+    /// Per-vertex areas (length `d`), as [`Descriptors::vertex_areas`].
+    pub vertex_areas: Vec<f64>,
+}
+
+impl ShapeBands {
+    /// The compact part of `data`.
+    pub fn of(data: &ShapeData) -> Self {
+        Self {
+            key: data.key,
+            bands: data.bands.clone(),
+            vertex_areas: data.descriptors.vertex_areas.clone(),
+        }
+    }
+
+    /// `Err(reason)` unless these data are keyed `key` and sized for a mesh of `vertices`
+    /// vertices (the check of a compact cache entry before it is trusted).
+    pub(crate) fn check(&self, key: &ShapeKey, vertices: usize) -> Result<(), String> {
+        if self.key != *key {
+            return Err("payload key does not match".into());
+        }
+        let t = &self.bands;
+        let consistent = t.vertices == vertices
+            && t.labels.len() == t.features * vertices
+            && t.labels.iter().all(|&l| (l as usize) < t.bands)
+            && self.vertex_areas.len() == vertices;
+        if !consistent {
+            return Err("payload sizes do not match the mesh".into());
+        }
+        if !self.vertex_areas.iter().all(|a| a.is_finite()) {
+            return Err("payload holds non-finite vertex areas".into());
+        }
+        Ok(())
+    }
+}
+
+impl ShapeData {
+    /// `Err(reason)` unless these data are keyed `key` and sized for a mesh of `vertices`
+    /// vertices (the check of a full cache entry before it is trusted).
+    pub(crate) fn check(&self, key: &ShapeKey, vertices: usize) -> Result<(), String> {
+        if self.key != *key {
+            return Err("payload key does not match".into());
+        }
+        let n = self.descriptors.feature_count();
+        let consistent = self.vertices == vertices
+            && self.spectrum.vertex_count() == vertices
+            && self.spectrum.eigenvectors.len() == vertices * self.spectrum.len()
+            && self.descriptors.vertices == vertices
+            && self.descriptors.values.len() == n * vertices
+            && self.bands.vertices == vertices
+            && self.bands.features == n
+            && self.bands.labels.len() == n * vertices
+            && self.spectrum.vertex_areas.len() == vertices
+            && self.descriptors.vertex_areas.len() == vertices
+            && self
+                .bands
+                .labels
+                .iter()
+                .all(|&l| (l as usize) < self.bands.bands);
+        if !consistent {
+            return Err("payload sizes do not match the mesh".into());
+        }
+        // A checksum only proves the bytes are the ones written; NaN must never come out of
+        // the cache into a stage (or an output file), whoever wrote the entry.
+        let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
+        if !(finite(&self.spectrum.eigenvalues)
+            && finite(&self.spectrum.eigenvectors)
+            && finite(&self.spectrum.vertex_areas)
+            && finite(&self.descriptors.values)
+            && finite(&self.descriptors.vertex_areas))
+        {
+            return Err("payload holds non-finite numbers".into());
+        }
+        Ok(())
+    }
+}
+
+/// The cache key of a mesh under the pipeline's options ([`crate::cache::entry_key`]).
+///
+/// ```
+/// use coseg::{mesh::TriMesh, pipeline::{shape_key, ShapePipelineOptions}};
+/// let m = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
+/// let mut o = ShapePipelineOptions::default();
+/// let k1 = shape_key(&m, &o);
+/// o.bands.bands = 10;
+/// assert_ne!(k1, shape_key(&m, &o));
+/// ```
+pub fn shape_key(mesh: &TriMesh, options: &ShapePipelineOptions) -> ShapeKey {
+    entry_key(mesh, options)
+}
+
+/// The bytes of the full cache entry of `data`.
+pub fn encode_shape_entry(data: &ShapeData) -> Vec<u8> {
+    encode_entry(EntryKind::Full, &data.key, data)
+}
+
+/// The bytes of the compact bands entry of `data`.
+pub fn encode_bands_entry(data: &ShapeBands) -> Vec<u8> {
+    encode_entry(EntryKind::Bands, &data.key, data)
+}
+
+/// Spectrum, descriptors and band table of a mesh, without touching any cache.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, pipeline::{compute_shape_data, ShapePipelineOptions}};
+/// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
+/// let mut o = ShapePipelineOptions::default();
+/// o.spectrum.eigenpairs = 4;
+/// o.bands.bands = 2;
+/// let data = compute_shape_data(&m, &o).unwrap();
+/// assert_eq!(data.bands.features, 300);
+/// ```
+pub fn compute_shape_data(
+    mesh: &TriMesh,
+    options: &ShapePipelineOptions,
+) -> Result<ShapeData, PipelineError> {
+    let mut spectrum_options = options.spectrum.clone();
+    spectrum_options.eigenpairs = spectrum_options.eigenpairs.min(available_eigenpairs(mesh));
+    let spectrum = laplace_beltrami_spectrum(mesh, &spectrum_options)?;
+    shape_data_from_spectrum(mesh, spectrum, options)
+}
+
+/// The warning for a mesh with fewer usable vertices than the eigenpairs `options` ask for
+/// (see [`crate::spectral::available_eigenpairs`]): [`compute_shape_data`] then computes as
+/// many eigenpairs as the mesh has, and every later stage works with that many (the map step
+/// fits a smaller first map). `None` when the mesh is large enough.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, pipeline::{small_mesh_warning, ShapePipelineOptions}};
+/// let m = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
+/// let w = small_mesh_warning(&m, &ShapePipelineOptions::default()).unwrap();
+/// assert!(w.contains("3 of the 200 eigenpairs"), "{w}");
+/// ```
+pub fn small_mesh_warning(mesh: &TriMesh, options: &ShapePipelineOptions) -> Option<String> {
+    let available = available_eigenpairs(mesh);
+    let asked = options.spectrum.eigenpairs;
+    (available < asked).then(|| {
+        format!(
+            "{available} vertices carry area: computing {available} of the {asked} eigenpairs asked for"
+        )
+    })
+}
+
+/// Verifies and decodes the bytes of a full cache entry written for `key` on a mesh of
+/// `vertices` vertices; `Err` says why it cannot be trusted (frame, decoding, sizes,
+/// non-finite numbers: see [`crate::cache::read_entry`]). Never panics, whatever the bytes.
+///
+/// ```
+/// use coseg::mesh::TriMesh;
+/// use coseg::pipeline::{compute_shape_data, decode_shape_entry, encode_shape_entry, ShapePipelineOptions};
+/// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
+/// let mut o = ShapePipelineOptions::default();
+/// o.spectrum.eigenpairs = 4;
+/// o.bands.bands = 2;
+/// let data = compute_shape_data(&m, &o).unwrap();
+/// let mut bytes = encode_shape_entry(&data);
+/// assert_eq!(decode_shape_entry(&bytes, &data.key, 4).unwrap(), data);
+/// *bytes.last_mut().unwrap() ^= 1; // one flipped bit: the checksum no longer matches
+/// assert!(decode_shape_entry(&bytes, &data.key, 4).unwrap_err().contains("checksum"));
+/// ```
+pub fn decode_shape_entry(
+    bytes: &[u8],
+    key: &ShapeKey,
+    vertices: usize,
+) -> Result<ShapeData, String> {
+    decode_entry(bytes, EntryKind::Full, key, |d: &ShapeData| {
+        d.check(key, vertices)
+    })
+}
+
+/// [`decode_shape_entry`] for a compact bands entry.
+///
+/// ```
+/// use coseg::bands::equal_count_bands;
+/// use coseg::cache::ShapeKey;
+/// use coseg::pipeline::{decode_bands_entry, encode_bands_entry, ShapeBands};
+/// let bands = equal_count_bands(&[0.0, 1.0, 2.0], 1, 3, 2).unwrap();
+/// let data = ShapeBands { key: ShapeKey([7; 32]), bands, vertex_areas: vec![1.0 / 3.0; 3] };
+/// let bytes = encode_bands_entry(&data);
+/// assert_eq!(decode_bands_entry(&bytes, &data.key, 3).unwrap(), data);
+/// assert!(decode_bands_entry(&bytes[..bytes.len() - 1], &data.key, 3).is_err());
+/// ```
+pub fn decode_bands_entry(
+    bytes: &[u8],
+    key: &ShapeKey,
+    vertices: usize,
+) -> Result<ShapeBands, String> {
+    decode_entry(bytes, EntryKind::Bands, key, |d: &ShapeBands| {
+        d.check(key, vertices)
+    })
+}
+
+/// Descriptors and band table from an already computed spectrum (e.g. read elsewhere), keyed
+/// as [`compute_shape_data`] would key them. The spectrum must be the one
+/// `options.spectrum` gives for `mesh`, or the cache key would lie.
+pub fn shape_data_from_spectrum(
+    mesh: &TriMesh,
+    spectrum: Spectrum,
+    options: &ShapePipelineOptions,
+) -> Result<ShapeData, PipelineError> {
+    let descriptors = descriptors(mesh, &spectrum, &options.descriptors)?;
+    let bands = band_table(&descriptors, &options.bands)?;
+    Ok(ShapeData {
+        key: shape_key(mesh, options),
+        vertices: mesh.vertex_count(),
+        spectrum,
+        descriptors,
+        bands,
+    })
+}

@@ -1,0 +1,220 @@
+//! Tests of the adaptive co-segmentation (parts of their own size, `coseg::graph::adaptive_cosegment`).
+
+use coseg::bands::{BandTable, equal_count_bands};
+use coseg::graph::{
+    AdaptiveOptions, GraphOptions, PartTree, ShapeGraph, ShapeNode, Sizing, StopReason,
+    adaptive_cosegment, adaptive_update,
+};
+use rand_chacha::ChaCha8Rng;
+use rand_chacha::rand_core::{Rng, SeedableRng};
+
+fn uniform(rng: &mut ChaCha8Rng) -> f64 {
+    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Part of every vertex: `fractions` of the vertices, in blocks, after a seeded shuffle (so
+/// parts are not index ranges).
+fn part_labels(vertices: usize, fractions: &[f64], seed: u64) -> Vec<usize> {
+    let mut labels = Vec::with_capacity(vertices);
+    let mut acc = 0.0;
+    for (p, f) in fractions.iter().enumerate() {
+        acc += f;
+        let end = if p + 1 == fractions.len() {
+            vertices
+        } else {
+            (acc * vertices as f64).round() as usize
+        };
+        labels.resize(end, p);
+    }
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    for i in (1..vertices).rev() {
+        let j = (rng.next_u64() % (i as u64 + 1)) as usize;
+        labels.swap(i, j);
+    }
+    labels
+}
+
+/// A shape whose parts have distinct feature profiles: feature `k` of a vertex of part `p` is
+/// `centre[p][k]` (the same on every shape, seeded by `profile_seed`) plus `noise` × uniform.
+fn shape_table(labels: &[usize], parts: usize, noise: f64, seed: u64) -> BandTable {
+    let features = 24;
+    let mut prof = ChaCha8Rng::seed_from_u64(7);
+    let centre: Vec<Vec<f64>> = (0..parts)
+        .map(|_| (0..features).map(|_| uniform(&mut prof)).collect())
+        .collect();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let d = labels.len();
+    let mut values = vec![0.0; features * d];
+    for k in 0..features {
+        for (v, &p) in labels.iter().enumerate() {
+            values[k * d + v] = centre[p][k] + noise * uniform(&mut rng);
+        }
+    }
+    equal_count_bands(&values, features, d, 10).unwrap()
+}
+
+/// Four shapes of 3 parts with unequal, shape-dependent areas.
+fn collection() -> (ShapeGraph, Vec<Vec<usize>>, Vec<Vec<f64>>) {
+    let sizes = [300, 360, 280, 330];
+    let mut labels = Vec::new();
+    let mut truth = Vec::new();
+    let mut nodes = Vec::new();
+    for (i, &d) in sizes.iter().enumerate() {
+        let big = 0.52 + 0.03 * (i % 3) as f64;
+        let mid = 0.30 - 0.02 * (i % 2) as f64;
+        let fr = vec![big, mid, 1.0 - big - mid];
+        let l = part_labels(d, &fr, 11 + i as u64);
+        let t = shape_table(&l, 3, 0.25, 100 + i as u64);
+        nodes.push(ShapeNode::new(format!("s{i}"), t, &vec![1.0; d]).unwrap());
+        truth.push(fr);
+        labels.push(l);
+    }
+    let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
+    (g, labels, truth)
+}
+
+#[test]
+fn every_returned_tuple_is_a_fixed_point_of_its_update() {
+    let (g, _, _) = collection();
+    for sizing in [Sizing::Otsu, Sizing::LastThreshold] {
+        let mut o = AdaptiveOptions::default();
+        o.sizing = sizing;
+        o.min_area = 0.0;
+        o.min_separation = 0.0;
+        let a = adaptive_cosegment(&g, &o).unwrap();
+        assert!(!a.auto.is_empty(), "{sizing:?}: no tuple extracted");
+        for (r, auto) in a.auto.iter().enumerate() {
+            let t = &a.leaves.tuples[r];
+            assert!(t.converged, "{sizing:?}: tuple {r} did not converge");
+            let rem: Vec<Vec<u32>> = (0..4).map(|i| a.leaves.remaining_before(r, i)).collect();
+            let next = adaptive_update(&g, &rem, &t.regions, &auto.alphas).unwrap();
+            assert_eq!(
+                next, t.regions,
+                "{sizing:?}: tuple {r} moves under its update"
+            );
+        }
+    }
+}
+
+#[test]
+fn sizes_follow_the_data_on_unequal_parts() {
+    let (g, labels, truth) = collection();
+    let a = adaptive_cosegment(&g, &AdaptiveOptions::default()).unwrap();
+    let leaves = &a.leaves;
+    assert_eq!(leaves.tuples.len(), 3, "stop {:?}", a.stop);
+    // Each found part is one true part, recovered on every shape with its own area.
+    let mut matched = Vec::new();
+    for t in &leaves.tuples {
+        let mut hits = [0usize; 3];
+        for &v in &t.regions[0] {
+            hits[labels[0][v as usize]] += 1;
+        }
+        let p = (0..3).max_by_key(|&p| hits[p]).unwrap();
+        matched.push(p);
+        for i in 0..4 {
+            let found = t.area_fractions[i];
+            assert!(
+                (found - truth[i][p]).abs() <= 0.03,
+                "shape {i} part {p}: found {found:.3}, true {:.3}",
+                truth[i][p]
+            );
+            let pure = t.regions[i]
+                .iter()
+                .filter(|&&v| labels[i][v as usize] == p)
+                .count();
+            assert!(pure as f64 >= 0.95 * t.regions[i].len() as f64);
+        }
+    }
+    matched.sort_unstable();
+    assert_eq!(matched, vec![0, 1, 2]);
+}
+
+#[test]
+fn deterministic_across_thread_counts() {
+    let (g, _, _) = collection();
+    let run = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| adaptive_cosegment(&g, &AdaptiveOptions::default()).unwrap())
+    };
+    let (one, two) = (run(1), run(2));
+    assert_eq!(one, two);
+    assert_eq!(
+        serde_json::to_string(&one).unwrap(),
+        serde_json::to_string(&two).unwrap()
+    );
+}
+
+#[test]
+fn parts_n_cuts_the_tree_and_the_cut_partitions_every_shape() {
+    let (g, _, _) = collection();
+    let a = adaptive_cosegment(&g, &AdaptiveOptions::default()).unwrap();
+    assert_eq!(a.tree.merges.len(), a.tree.leaves - 1);
+    for parts in 1..=a.tree.leaves {
+        let c = a.cut(parts);
+        assert_eq!(c.tuples.len(), parts);
+        assert!(c.tuples.last().unwrap().leftover);
+        for i in 0..4 {
+            let l = c.labels(i);
+            assert!(l.iter().all(|&x| x >= 0 && (x as usize) < parts));
+        }
+    }
+}
+
+#[test]
+fn forced_part_count_ignores_the_levels() {
+    let (g, _, _) = collection();
+    let mut o = AdaptiveOptions::default();
+    o.min_confidence = 2.0; // no tuple can pass
+    let a = adaptive_cosegment(&g, &o).unwrap();
+    assert!(matches!(a.stop, StopReason::LowConfidence { .. }));
+    assert_eq!(a.leaves.tuples.len(), 1);
+    o.parts = Some(3);
+    let b = adaptive_cosegment(&g, &o).unwrap();
+    assert!(b.leaves.tuples.len() >= 3, "stop {:?}", b.stop);
+}
+
+#[test]
+fn tree_cut_groups_leaves() {
+    let t = PartTree {
+        leaves: 4,
+        merges: vec![
+            coseg::graph::PartMerge {
+                a: 1,
+                b: 3,
+                similarity: 0.9,
+            },
+            coseg::graph::PartMerge {
+                a: 0,
+                b: 4,
+                similarity: 0.7,
+            },
+            coseg::graph::PartMerge {
+                a: 5,
+                b: 2,
+                similarity: 0.1,
+            },
+        ],
+    };
+    assert_eq!(t.cut(4), vec![vec![0], vec![1], vec![2], vec![3]]);
+    assert_eq!(t.cut(3), vec![vec![0], vec![1, 3], vec![2]]);
+    assert_eq!(t.cut(2), vec![vec![0, 1, 3], vec![2]]);
+    assert_eq!(t.cut(1), vec![vec![0, 1, 2, 3]]);
+    assert_eq!(t.cut(0), vec![vec![0, 1, 2, 3]]);
+}
+
+#[test]
+fn bad_options_are_errors() {
+    let (g, _, _) = collection();
+    let mut o = AdaptiveOptions::default();
+    o.delta_t = 0.0;
+    assert!(adaptive_cosegment(&g, &o).is_err());
+    let mut o = AdaptiveOptions::default();
+    o.parts = Some(0);
+    assert!(adaptive_cosegment(&g, &o).is_err());
+    let mut o = AdaptiveOptions::default();
+    o.root = Some(9);
+    assert!(adaptive_cosegment(&g, &o).is_err());
+}

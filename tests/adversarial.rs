@@ -1,0 +1,553 @@
+//! Every command of the real `coseg` binary on a generated adversarial corpus
+//! (`tests/common/adversarial.rs`: several components, single triangles, non-manifold edges
+//! and vertices, zero-area and needle triangles, duplicate and unreferenced vertices,
+//! inconsistent orientation, 1e-8 and 1e8 scales, meshes smaller than the eigenpair count, a
+//! strip two vertices wide), and the regression tests of issue #21.
+//!
+//! On each mesh a command either succeeds (warnings allowed) or refuses with a message that
+//! names the file and the reason; it never panics; no output file holds a NaN or an infinity.
+
+mod common;
+
+use common::adversarial::{Case, base_sphere, corpus, with_surface_debris, write_case};
+use common::generate::collections_dir;
+use coseg::mesh::{TriMesh, read_mesh, write_mesh};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// A fresh, empty scratch folder `name` under Cargo's per-target temporary directory.
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("adversarial")
+        .join(name);
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn coseg<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .args(args)
+        .output()
+        .expect("the coseg binary runs")
+}
+
+fn text(o: &Output) -> (String, String) {
+    (
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+/// Small per-shape options so that the corpus runs in seconds unoptimised; the eigenpair
+/// count (60) is still above the small meshes' vertex counts.
+const PIPE: &[&str] = &[
+    "--eigenpairs",
+    "60",
+    "--hks",
+    "16",
+    "--wks",
+    "16",
+    "--curvature",
+    "16",
+    "--bands",
+    "8",
+];
+
+/// What a command did on one mesh.
+#[derive(Debug, PartialEq)]
+enum Verdict {
+    Succeeded,
+    Refused,
+}
+
+/// Checks the contract on one command's result: no panic; success (0, or 3 = some inputs
+/// skipped) or a refusal (1) whose message names `file`.
+fn verdict(what: &str, file: &str, o: &Output) -> Verdict {
+    let (stdout, stderr) = text(o);
+    assert!(
+        !stderr.contains("panicked") && !stderr.contains("RUST_BACKTRACE"),
+        "{what}: panicked\n{stderr}"
+    );
+    match o.status.code() {
+        Some(0) | Some(3) => Verdict::Succeeded,
+        Some(1) => {
+            assert!(
+                stderr.contains("error: ") && stderr.contains(file),
+                "{what}: refusal does not name {file}:\n{stderr}"
+            );
+            Verdict::Refused
+        }
+        code => panic!("{what}: exit {code:?}\nstdout:\n{stdout}\nstderr:\n{stderr}"),
+    }
+}
+
+/// Every output file under `dir` (recursively, the cache excepted) holds no NaN or infinity:
+/// text files have no `nan`/`inf` token and no `null` among JSON numbers, PLY meshes read back
+/// (the reader rejects non-finite coordinates), `.npy` arrays are finite.
+fn assert_no_nan(dir: &Path) {
+    let mut stack = vec![dir.to_path_buf()];
+    let mut checked = 0;
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            let name = path.file_name().unwrap().to_string_lossy().into_owned();
+            if path.is_dir() {
+                if name != ".cache" {
+                    stack.push(path);
+                }
+                continue;
+            }
+            checked += 1;
+            let ext = path.extension().map(|e| e.to_string_lossy().into_owned());
+            match ext.as_deref() {
+                Some("ply") | Some("off") | Some("obj") => {
+                    read_mesh(&path).unwrap_or_else(|e| panic!("{e}"));
+                }
+                Some("npy") => {
+                    let bytes = std::fs::read(&path).unwrap();
+                    let npy = npyz::NpyFile::new(&bytes[..]).unwrap();
+                    let values: Vec<f64> = npy.into_vec().unwrap_or_default();
+                    assert!(
+                        values.iter().all(|x| x.is_finite()),
+                        "{}: non-finite value",
+                        path.display()
+                    );
+                }
+                Some("json") => {
+                    let v: serde_json::Value =
+                        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+                    check_json(&v, &path.display().to_string(), "");
+                }
+                _ => {
+                    let t = std::fs::read_to_string(&path).unwrap();
+                    for tok in t.split(|c: char| c.is_whitespace() || c == ',') {
+                        let l = tok.to_ascii_lowercase();
+                        assert!(
+                            !(l.contains("nan") || l.contains("inf")),
+                            "{}: token {tok:?}",
+                            path.display()
+                        );
+                    }
+                }
+            }
+        }
+    }
+    assert!(checked > 0, "{}: no output file", dir.display());
+}
+
+/// serde_json writes a NaN as `null`: no array may mix numbers and nulls or hold only nulls,
+/// and no numeric field may be null where its siblings in an array of objects are numbers.
+fn check_json(v: &serde_json::Value, file: &str, at: &str) {
+    use serde_json::Value;
+    match v {
+        Value::Array(items) => {
+            let nulls = items.iter().filter(|x| x.is_null()).count();
+            assert!(nulls == 0, "{file}: null (a NaN?) in array {at}");
+            if items.iter().all(|x| x.is_object()) {
+                let keys: std::collections::BTreeSet<&String> = items
+                    .iter()
+                    .flat_map(|x| x.as_object().unwrap().keys())
+                    .collect();
+                for k in keys {
+                    let numbers = items.iter().filter(|x| x[k].is_number()).count();
+                    let nulls = items.iter().filter(|x| x[k].is_null()).count();
+                    assert!(
+                        numbers == 0 || nulls == 0,
+                        "{file}: {at}[].{k} mixes numbers and nulls (a NaN?)"
+                    );
+                }
+            }
+            for (i, x) in items.iter().enumerate() {
+                check_json(x, file, &format!("{at}[{i}]"));
+            }
+        }
+        Value::Object(map) => {
+            for (k, x) in map {
+                check_json(x, file, &format!("{at}.{k}"));
+            }
+        }
+        _ => {}
+    }
+}
+
+/// Runs `info`, `spectrum`, `features`, `pair` (against a clean sphere, and against itself)
+/// and `segment` (with two clean spheres) on `case`; returns the verdict of each.
+fn run_all(case: &Case, root: &Path, partner: &Path) -> Vec<(String, Verdict)> {
+    let dir = root.join(case.file.replace('.', "_"));
+    std::fs::create_dir_all(&dir).unwrap();
+    let input = dir.join("input");
+    std::fs::create_dir_all(&input).unwrap();
+    let mesh = write_case(&input, case);
+    let file = case.file;
+    let cache = root.join("cache");
+    let mut out = Vec::new();
+    let mut record = |what: &str, o: Output, outputs: Option<&Path>| {
+        let label = format!("{what} on {file} ({})", case.what);
+        let v = verdict(&label, file, &o);
+        if v == Verdict::Succeeded
+            && let Some(d) = outputs
+        {
+            assert_no_nan(d);
+        }
+        out.push((what.to_string(), v));
+    };
+
+    let o = coseg(&["info".as_ref(), mesh.as_os_str()]);
+    record("info", o, None);
+
+    let o = coseg(&[
+        "spectrum".as_ref(),
+        mesh.as_os_str(),
+        "-k".as_ref(),
+        "60".as_ref(),
+        "--json".as_ref(),
+    ]);
+    let spectrum_dir = dir.join("spectrum");
+    std::fs::create_dir_all(&spectrum_dir).unwrap();
+    std::fs::write(spectrum_dir.join("spectrum.json"), &o.stdout).unwrap();
+    let ok = o.status.success();
+    record("spectrum", o, ok.then_some(spectrum_dir.as_path()));
+
+    for format in ["npy", "csv"] {
+        let fdir = dir.join(format!("features_{format}"));
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "features".into(),
+            mesh.clone().into(),
+            "-o".into(),
+            fdir.clone().into(),
+            "--format".into(),
+            format.into(),
+            "--cache".into(),
+            cache.clone().into(),
+        ];
+        args.extend(PIPE.iter().map(Into::into));
+        record(&format!("features {format}"), coseg(&args), Some(&fdir));
+    }
+
+    for (what, other) in [("pair with a sphere", partner), ("pair with itself", &mesh)] {
+        let pdir = dir.join(what.replace(' ', "_"));
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "pair".into(),
+            mesh.clone().into(),
+            other.into(),
+            "-o".into(),
+            pdir.clone().into(),
+            "--cache".into(),
+            cache.clone().into(),
+            "--refine-rounds".into(),
+            "3".into(),
+            "--map-size".into(),
+            "30".into(),
+        ];
+        args.extend(PIPE.iter().map(Into::into));
+        record(what, coseg(&args), Some(&pdir));
+    }
+
+    let folder = dir.join("collection");
+    std::fs::create_dir_all(&folder).unwrap();
+    std::fs::copy(&mesh, folder.join(file)).unwrap();
+    for seed in [11, 12] {
+        let (p, f) = base_sphere(seed);
+        write_mesh(
+            folder.join(format!("sphere{seed}.off")),
+            &TriMesh::new(p, f).unwrap(),
+            &[],
+        )
+        .unwrap();
+    }
+    let sdir = dir.join("segment");
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "segment".into(),
+        folder.into(),
+        "-o".into(),
+        sdir.clone().into(),
+        "--cache".into(),
+        cache.into(),
+        "--regions".into(),
+        "3".into(),
+        "--refine-rounds".into(),
+        "3".into(),
+    ];
+    args.extend(PIPE.iter().map(Into::into));
+    record("segment", coseg(&args), Some(&sdir));
+    out
+}
+
+/// The whole corpus through every command. Every case must succeed on every command: each
+/// of these meshes is one the method can work on (with warnings), so a refusal is a bug.
+#[test]
+fn every_command_on_the_adversarial_corpus_succeeds_without_nan() {
+    let root = scratch("corpus");
+    let partner = root.join("partner.off");
+    let (p, f) = base_sphere(10);
+    write_mesh(&partner, &TriMesh::new(p, f).unwrap(), &[]).unwrap();
+    let mut table = Vec::new();
+    for case in corpus() {
+        for (what, v) in run_all(&case, &root, &partner) {
+            table.push(format!("{:<18} {:<24} {v:?}", case.file, what));
+            assert_eq!(
+                v,
+                Verdict::Succeeded,
+                "{what} refused {} ({})",
+                case.file,
+                case.what
+            );
+        }
+    }
+    println!("{}", table.join("\n"));
+}
+
+/// Regression (#21, case 1): on a shape with disjoint small pieces (a shipped quadruped with 30
+/// single triangles lying on its surface, unconnected) the map step failed the whole pair with
+/// `eigensolver failed: ZoomOut: sampled eigenbasis is singular`. Now the step runs (its
+/// samples cover every basis function, its fit is null-space aware) and summary.json lists
+/// no fallback.
+#[test]
+fn pair_on_multi_component_shapes_runs_the_map_step() {
+    let dir = scratch("multi_component_pair");
+    let shipped = |n: &str| {
+        let m = read_mesh(collections_dir().join("quadrupeds").join(n)).unwrap();
+        (m.positions().to_vec(), m.faces().to_vec())
+    };
+    let a = dir.join("a.off");
+    let b = dir.join("b.off");
+    for (path, name) in [(&a, "quadrupeds_01.obj"), (&b, "quadrupeds_03.obj")] {
+        let (p, f) = with_surface_debris(shipped(name), 30, 0.005);
+        write_mesh(path, &TriMesh::new(p, f).unwrap(), &[]).unwrap();
+    }
+    let out = dir.join("out");
+    let o = coseg(&[
+        "pair".as_ref(),
+        a.as_os_str(),
+        b.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--eigenpairs".as_ref(),
+        "60".as_ref(),
+        "--map-size".as_ref(),
+        "60".as_ref(),
+    ]);
+    let (_, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(!stderr.contains("singular"), "{stderr}");
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(out.join("summary.json")).unwrap()).unwrap();
+    assert!(summary["map_guided"].is_object(), "{summary}");
+    assert_eq!(summary["fallbacks"], serde_json::json!([]), "{summary}");
+    assert_no_nan(&out);
+}
+
+/// Regression (#21, case 2): `coseg segment same -o same` wrote `<name>.regions.ply` beside
+/// the meshes and the next run read them as new shapes (6 from 3). coseg's own outputs are now
+/// left out, with a warning naming them, and the second run co-segments the same 3 shapes
+/// into byte-identical files.
+#[test]
+fn segment_into_its_own_input_folder_does_not_read_its_outputs() {
+    let dir = scratch("same_folder");
+    for seed in [1, 2, 3] {
+        let (p, f) = base_sphere(seed);
+        write_mesh(
+            dir.join(format!("s{seed}.off")),
+            &TriMesh::new(p, f).unwrap(),
+            &[],
+        )
+        .unwrap();
+    }
+    let run = || {
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "segment".into(),
+            dir.clone().into(),
+            "-o".into(),
+            dir.clone().into(),
+            "--regions".into(),
+            "3".into(),
+        ];
+        args.extend(PIPE.iter().map(Into::into));
+        coseg(&args)
+    };
+    let first = run();
+    let (stdout, stderr) = text(&first);
+    assert!(first.status.success(), "{stderr}");
+    assert!(stdout.contains("3 shapes co-segmented"), "{stdout}");
+    let before = std::fs::read(dir.join("s1.regions.txt")).unwrap();
+    let second = run();
+    let (stdout, stderr) = text(&second);
+    assert!(second.status.success(), "{stderr}");
+    assert!(stdout.contains("3 shapes co-segmented"), "{stdout}");
+    assert!(
+        stderr.contains("not reading 3 file(s)") && stderr.contains("s1.regions.ply"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read(dir.join("s1.regions.txt")).unwrap(), before);
+}
+
+/// Regression (#21, case 3): `g.obj` and `g.off` in one folder stopped the run with
+/// `invalid shape name "g (duplicate)"`. They are now named `g_obj` and `g_off` (documented
+/// in `coseg::graph::load_collection`), with a warning.
+#[test]
+fn two_files_with_one_stem_get_distinct_output_names() {
+    let dir = scratch("one_stem");
+    let input = dir.join("in");
+    std::fs::create_dir_all(&input).unwrap();
+    for (seed, name) in [(1, "g.obj"), (2, "g.off"), (3, "h.ply")] {
+        let (p, f) = base_sphere(seed);
+        write_mesh(input.join(name), &TriMesh::new(p, f).unwrap(), &[]).unwrap();
+    }
+    let out = dir.join("out");
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "segment".into(),
+        input.into(),
+        "-o".into(),
+        out.clone().into(),
+        "--regions".into(),
+        "3".into(),
+    ];
+    args.extend(PIPE.iter().map(Into::into));
+    let o = coseg(&args);
+    let (_, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stderr.contains("share the stem \"g\""), "{stderr}");
+    for name in ["g_obj", "g_off", "h"] {
+        assert!(out.join(format!("{name}.regions.txt")).is_file(), "{name}");
+        assert!(out.join(format!("{name}.regions.ply")).is_file(), "{name}");
+    }
+}
+
+/// Regression (#21, case 4; #18): a mesh with fewer vertices than `--eigenpairs` was an error
+/// in `spectrum`, `features`, `pair` and `segment` alike; now every stage computes as many
+/// eigenpairs as the mesh has and says so.
+#[test]
+fn a_mesh_smaller_than_the_eigenpair_count_runs_everywhere_with_a_warning() {
+    let dir = scratch("small_mesh");
+    let small = corpus()
+        .into_iter()
+        .find(|c| c.file == "tetrahedron.off")
+        .unwrap();
+    let mesh = write_case(&dir, &small);
+    let o = coseg(&[
+        "spectrum".as_ref(),
+        mesh.as_os_str(),
+        "-k".as_ref(),
+        "200".as_ref(),
+    ]);
+    let (stdout, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert_eq!(stdout.lines().count(), 4, "{stdout}");
+    assert!(stderr.contains("4 of the 200 eigenpairs"), "{stderr}");
+    let fdir = dir.join("features");
+    let o = coseg(&[
+        "features".as_ref(),
+        mesh.as_os_str(),
+        "-o".as_ref(),
+        fdir.as_os_str(),
+    ]);
+    let (_, stderr) = text(&o);
+    assert!(o.status.success(), "{stderr}");
+    assert!(stderr.contains("4 of the 200 eigenpairs"), "{stderr}");
+    assert_no_nan(&fdir);
+}
+
+/// Regression (#18): a missing file was reported as `…: No such file or directory (os error
+/// 2): No such file or directory (os error 2)`. Each cause is now printed once.
+#[test]
+fn a_missing_file_is_reported_once() {
+    let dir = scratch("missing");
+    let missing = dir.join("missing.off");
+    for args in [
+        vec!["info".into(), missing.clone().into_os_string()],
+        vec!["spectrum".into(), missing.clone().into_os_string()],
+        vec![
+            "pair".into(),
+            missing.clone().into_os_string(),
+            missing.clone().into_os_string(),
+            "-o".into(),
+            dir.join("out").into_os_string(),
+        ],
+        vec![
+            "features".into(),
+            missing.clone().into_os_string(),
+            "-o".into(),
+            dir.join("out").into_os_string(),
+        ],
+    ] {
+        let o = coseg(&args);
+        let (_, stderr) = text(&o);
+        assert!(!o.status.success());
+        assert!(stderr.contains("missing.off"), "{stderr}");
+        assert_eq!(
+            stderr.matches("No such file or directory").count(),
+            1,
+            "{args:?}: {stderr}"
+        );
+    }
+}
+
+/// An optional stage that cannot run leaves the previous stage's regions and says why: here
+/// the map step gets shapes carrying different descriptor counts (its validation rejects
+/// them), and the result is exactly the run without the map step.
+#[test]
+fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run() {
+    use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
+    use coseg::stable::{PairShape, PairStage, SegmentPairOptions, segment_pair};
+    let mut pipe = ShapePipelineOptions::default();
+    pipe.spectrum.eigenpairs = 40;
+    pipe.descriptors.hks_count = 8;
+    pipe.descriptors.wks_count = 8;
+    pipe.descriptors.curvature_count = 8;
+    pipe.bands.bands = 6;
+    let meshes: Vec<TriMesh> = [1, 2]
+        .iter()
+        .map(|&s| {
+            let (p, f) = base_sphere(s);
+            TriMesh::new(p, f).unwrap()
+        })
+        .collect();
+    let data: Vec<_> = meshes
+        .iter()
+        .map(|m| compute_shape_data(m, &pipe).unwrap())
+        .collect();
+    let d = meshes[1].vertex_count();
+    let b_values = &data[1].descriptors.values;
+    // B loses its last descriptor column.
+    let descriptors = [
+        &data[0].descriptors.values[..],
+        &b_values[..b_values.len() - d],
+    ];
+    let shape = |i: usize| PairShape {
+        mesh: &meshes[i],
+        spectrum: &data[i].spectrum,
+        bands: &data[i].bands,
+        descriptors: Some(descriptors[i]),
+    };
+    let mut options = SegmentPairOptions::default();
+    options
+        .map_guided
+        .as_mut()
+        .unwrap()
+        .point_map
+        .zoomout
+        .final_size = 40;
+    let out = segment_pair(shape(0), shape(1), &options).unwrap();
+    assert_eq!(out.fallbacks.len(), 1, "{:?}", out.fallbacks);
+    assert_eq!(out.fallbacks[0].stage, PairStage::MapGuided);
+    assert!(
+        out.fallbacks[0].reason.contains("descriptors"),
+        "{}",
+        out.fallbacks[0]
+    );
+    let without = SegmentPairOptions {
+        map_guided: None,
+        ..options.clone()
+    };
+    let reference = segment_pair(shape(0), shape(1), &without).unwrap();
+    assert!(reference.fallbacks.is_empty());
+    assert_eq!(out.regions.labels_b(), reference.regions.labels_b());
+    assert_eq!(out.regions.labels_a(), reference.regions.labels_a());
+    // A wrong option is still the caller's error, not a fallback.
+    let mut bad = options;
+    bad.map_guided.as_mut().unwrap().map_weight = f64::NAN;
+    assert!(segment_pair(shape(0), shape(1), &bad).is_err());
+}
