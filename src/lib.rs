@@ -21,6 +21,7 @@
 //! | output | [`output`] | region files, coloured meshes, summaries, the viewer page |
 //! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view) |
 //! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
+//! | propagation | [`propagate`] | part labels carried from annotated shapes to a collection |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
 //! | per-shape task | [`shape_task`] | the per-shape stage as bytes in, cache entry bytes out (for distributed engines) |
@@ -38,6 +39,7 @@ pub mod maps;
 pub mod mesh;
 pub mod output;
 pub mod pipeline;
+pub mod propagate;
 pub mod render;
 pub mod shape_task;
 pub mod spectral;

@@ -7,6 +7,7 @@ mod generate;
 mod info;
 mod pair;
 mod pipeline_args;
+mod propagate;
 mod render;
 mod segment;
 mod spectrum;
@@ -98,6 +99,11 @@ enum Command {
     /// correspondence ratio.
     #[command(after_help = "Example:\n  coseg eval out/ --truth shapes/ --json scores.json")]
     Eval(eval::EvalArgs),
+    /// Carry part labels from a few annotated meshes to every mesh of a folder.
+    #[command(after_help = "Example:\n  coseg propagate shapes/ --labels labelled/ -o out/\n\
+        Reads <stem>.seg (per face) or <stem>.labels.txt (per vertex) from --labels; writes \
+        out/<name>.labels.{txt,ply}, <name>.seg, summary.json.")]
+    Propagate(propagate::PropagateArgs),
 }
 
 static GLOBAL: OnceLock<GlobalArgs> = OnceLock::new();
@@ -177,6 +183,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Segment(args) => segment::run(args),
         Command::Render(args) => render::run(args),
         Command::Eval(args) => eval::run(args),
+        Command::Propagate(args) => propagate::run(args),
     }
 }
 

@@ -171,7 +171,7 @@ pub fn face_label_agreement(
 /// use coseg::mesh::TriMesh;
 /// let m = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
 /// let a = vertex_label_agreement(&m, &[0, 0, 1], &[0, 0, 1]).unwrap();
-/// assert_eq!(a.accuracy, 1.0);
+/// assert!((a.accuracy - 1.0).abs() < 1e-12);
 /// ```
 pub fn vertex_label_agreement(
     mesh: &TriMesh,

@@ -6,6 +6,9 @@ use std::collections::BTreeMap;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+/// Label files matched to meshes, `(mesh index, file)` by mesh index, and warnings.
+pub type MatchedLabels = (Vec<(usize, PathBuf)>, Vec<String>);
+
 /// Part names: `label → name`, carried into outputs.
 pub type PartNames = BTreeMap<i32, String>;
 
@@ -183,7 +186,7 @@ fn is_label_file(path: &Path) -> bool {
 pub fn match_label_files(
     inputs: &[PathBuf],
     stems: &[String],
-) -> Result<(Vec<(usize, PathBuf)>, Vec<String>), LabelError> {
+) -> Result<MatchedLabels, LabelError> {
     let index: BTreeMap<&str, usize> = stems
         .iter()
         .enumerate()

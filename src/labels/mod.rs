@@ -31,8 +31,8 @@ mod files;
 
 pub use convert::{faces_to_vertices, label_set, vertices_to_faces};
 pub use files::{
-    LabelKind, PartNames, ShapeLabels, label_file_stem, match_label_files, read_label_file,
-    read_part_names, read_shape_labels, write_face_labels, write_vertex_labels,
+    LabelKind, MatchedLabels, PartNames, ShapeLabels, label_file_stem, match_label_files,
+    read_label_file, read_part_names, read_shape_labels, write_face_labels, write_vertex_labels,
 };
 
 use thiserror::Error;

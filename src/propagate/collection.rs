@@ -1,0 +1,150 @@
+//! [`propagate_collection`]: a folder of meshes and its label files in one call.
+
+use super::{PropagateError, PropagateOptions, Propagation, propagate_labels};
+use crate::graph::{GraphOptions, ShapeGraph, SkippedFile, load_collection};
+use crate::labels::{LabelKind, PartNames, match_label_files, read_part_names, read_shape_labels};
+use crate::mesh::TriMesh;
+use crate::pipeline::ShapePipelineOptions;
+use crate::spectral::HeatSmoother;
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Options of [`propagate_collection`]: the per-shape pipeline, the graph and the solver.
+#[derive(Debug, Clone, Default, PartialEq)]
+#[non_exhaustive]
+pub struct PropagateCollectionOptions {
+    /// Spectrum, features and bands of every shape (the cache key).
+    pub pipeline: ShapePipelineOptions,
+    /// The shape graph (as `coseg segment` builds it).
+    pub graph: GraphOptions,
+    /// The solver.
+    pub propagate: PropagateOptions,
+    /// Per-shape cache folder (default: `coseg-cache` in the system's temporary folder; the
+    /// input folder is never written).
+    pub cache_dir: Option<PathBuf>,
+    /// Optional part names, a JSON `{label: name}` file.
+    pub part_names: Option<PathBuf>,
+}
+
+/// An annotation used as a source.
+#[derive(Debug, Clone, PartialEq)]
+pub struct SourceFile {
+    /// Index of the shape (graph order).
+    pub shape: usize,
+    /// The label file.
+    pub path: PathBuf,
+    /// Per-vertex or per-face file.
+    pub kind: LabelKind,
+}
+
+/// Result of [`propagate_collection`].
+#[derive(Debug)]
+pub struct PropagatedCollection {
+    /// Input mesh paths (graph order).
+    pub paths: Vec<PathBuf>,
+    /// The meshes (graph order).
+    pub meshes: Vec<TriMesh>,
+    /// The shape graph (nodes hold the band tables).
+    pub graph: ShapeGraph,
+    /// One heat smoother per shape (empty when smoothing is off or failed; see `warnings`).
+    pub smoothers: Vec<HeatSmoother>,
+    /// The labels, confidences and the state for [`Propagation::update`].
+    pub propagation: Propagation,
+    /// The annotations used.
+    pub sources: Vec<SourceFile>,
+    /// Part names (empty without a names file).
+    pub part_names: PartNames,
+    /// Mesh files that could not be used.
+    pub skipped: Vec<SkippedFile>,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+}
+
+impl PropagatedCollection {
+    /// The smoothers as the solver takes them.
+    pub fn smoothers(&self) -> Option<&[HeatSmoother]> {
+        (!self.smoothers.is_empty()).then_some(self.smoothers.as_slice())
+    }
+}
+
+/// Loads every mesh of `folder` through the per-shape cache, matches the label files of
+/// `labels` (folders matched by stem, or files; see [`match_label_files`]) to them, builds the
+/// shape graph and heat smoothers and runs [`propagate_labels`]. Unreadable meshes are skipped
+/// (listed in `skipped`); a label file that does not fit its mesh is an error naming it.
+///
+/// ```no_run
+/// use coseg::propagate::{propagate_collection, PropagateCollectionOptions};
+/// use std::path::{Path, PathBuf};
+/// let out = propagate_collection(Path::new("chairs"), &[PathBuf::from("chairs/gt/1.seg")],
+///     &PropagateCollectionOptions::default()).unwrap();
+/// println!("{} shapes labelled", out.propagation.labels.len());
+/// ```
+pub fn propagate_collection(
+    folder: &Path,
+    labels: &[PathBuf],
+    options: &PropagateCollectionOptions,
+) -> Result<PropagatedCollection, PropagateError> {
+    options.propagate.validate()?;
+    let cache = options
+        .cache_dir
+        .clone()
+        .unwrap_or_else(|| std::env::temp_dir().join("coseg-cache"));
+    let loaded = load_collection(folder, &options.pipeline, &cache, |_, _, _| {})?;
+    let mut warnings = loaded.warnings.clone();
+    let stems: Vec<String> = loaded.nodes.iter().map(|n| n.name.clone()).collect();
+    let (matched, w) = match_label_files(labels, &stems)?;
+    warnings.extend(w);
+    let mut annotations: Vec<Option<Vec<i32>>> = vec![None; stems.len()];
+    let mut sources = Vec::new();
+    for (i, path) in matched {
+        let l = read_shape_labels(&path, &loaded.meshes[i], &stems[i])?;
+        if l.vertex_labels.iter().all(|&x| x < 0) {
+            warnings.push(format!("{}: no labelled vertex, not used", path.display()));
+            continue;
+        }
+        sources.push(SourceFile {
+            shape: i,
+            path,
+            kind: l.kind,
+        });
+        annotations[i] = Some(l.vertex_labels);
+    }
+    if sources.is_empty() {
+        return Err(PropagateError::NoLabels);
+    }
+    let part_names = match &options.part_names {
+        Some(p) => read_part_names(p)?,
+        None => PartNames::new(),
+    };
+    let graph = ShapeGraph::build(loaded.nodes, &options.graph)?;
+    let time = options.propagate.smoothing_time;
+    let smoothers: Vec<HeatSmoother> = if time > 0.0 {
+        match loaded
+            .meshes
+            .par_iter()
+            .map(|m| HeatSmoother::new(m, time))
+            .collect::<Result<Vec<_>, _>>()
+        {
+            Ok(s) => s,
+            Err(e) => {
+                warnings.push(format!("heat smoothing off: {e}"));
+                Vec::new()
+            }
+        }
+    } else {
+        Vec::new()
+    };
+    let smooth = (!smoothers.is_empty()).then_some(smoothers.as_slice());
+    let propagation = propagate_labels(&graph, smooth, &annotations, &options.propagate)?;
+    Ok(PropagatedCollection {
+        paths: loaded.paths,
+        meshes: loaded.meshes,
+        graph,
+        smoothers,
+        propagation,
+        sources,
+        part_names,
+        skipped: loaded.skipped,
+        warnings,
+    })
+}

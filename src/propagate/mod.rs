@@ -1,0 +1,66 @@
+//! Label propagation: part labels from a few annotated shapes to a whole collection
+//! (docs/PROPAGATION.md argues the design).
+//!
+//! - [`propagate_labels`]: the solver on a [`ShapeGraph`](crate::graph::ShapeGraph):
+//!   annotated parts are fixed regions on their sources, transported through the band affinity
+//!   onto every shape, relayed by labelled neighbours over the graph, smoothed and sized.
+//! - [`Propagation::update`]: add or correct one annotation and re-propagate from the previous
+//!   state, reusing every transport whose voter did not change.
+//! - [`propagate_collection`]: a folder of meshes and a folder (or list) of label files in
+//!   one call, as `coseg propagate` runs it; [`write_propagation`] writes its files.
+
+mod collection;
+mod options;
+mod solve;
+mod write;
+
+pub use collection::{
+    PropagateCollectionOptions, PropagatedCollection, SourceFile, propagate_collection,
+};
+pub use options::PropagateOptions;
+pub use solve::{Propagation, UpdateStats, propagate_labels};
+pub use write::{PropagationSummary, write_propagation};
+
+use thiserror::Error;
+
+/// Errors of label propagation; each names the shape or file concerned.
+#[derive(Debug, Error)]
+pub enum PropagateError {
+    /// An option or argument is out of range.
+    #[error("invalid option: {0}")]
+    BadOption(String),
+    /// No shape carries a label.
+    #[error("no labelled shape: at least one annotation with a label ≥ 0 is needed")]
+    NoLabels,
+    /// A shape's annotation does not fit it.
+    #[error("shape {name}: {message}")]
+    Shape {
+        /// The shape's name.
+        name: String,
+        /// What is wrong.
+        message: String,
+    },
+    /// A heat smoother failed.
+    #[error("shape {name}: heat smoothing: {message}")]
+    Smoothing {
+        /// The shape's name.
+        name: String,
+        /// The spectral-stage error.
+        message: String,
+    },
+    /// The affinity operator rejected its input.
+    #[error(transparent)]
+    Affinity(#[from] crate::affinity::AffinityError),
+    /// The stable-region stage rejected its input.
+    #[error(transparent)]
+    Stable(#[from] crate::stable::StableError),
+    /// The collection stage (loading, graph) failed.
+    #[error(transparent)]
+    Graph(#[from] crate::graph::GraphError),
+    /// A label file is unreadable or does not fit its mesh.
+    #[error(transparent)]
+    Labels(#[from] crate::labels::LabelError),
+    /// Writing an output failed.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+}

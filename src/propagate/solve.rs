@@ -1,0 +1,608 @@
+//! [`propagate_labels`] and [`Propagation::update`]: part labels from a few labelled shapes to
+//! every shape of a graph.
+
+use super::{PropagateError, PropagateOptions};
+use crate::affinity::{BandAffinity, Direction, FeaturePairing};
+use crate::graph::ShapeGraph;
+use crate::spectral::HeatSmoother;
+use crate::stable::region_scores;
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+
+/// Result of [`propagate_labels`], and the state [`Propagation::update`] continues from.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Propagation {
+    /// The part labels (the annotation's integers), ascending; part `r` is `parts[r]`.
+    pub parts: Vec<i32>,
+    /// Per shape (graph order), per vertex: the label (`parts[r]`), `-1` only on a shape no
+    /// labelled shape reaches.
+    pub labels: Vec<Vec<i32>>,
+    /// Per shape, per vertex: confidence of the vertex's label, `(best − second) / best` of its
+    /// part scores (`0` = a tie, `1` = no other part scores at all; annotated vertices 1).
+    pub confidence: Vec<Vec<f64>>,
+    /// Per shape: area-weighted mean of `confidence` over its vertices.
+    pub shape_confidence: Vec<f64>,
+    /// Per shape, per part: area-weighted mean confidence over the part's vertices (`0` when
+    /// the part is absent).
+    pub part_confidence: Vec<Vec<f64>>,
+    /// Per shape, per part: share of the shape's area with that label.
+    pub part_shares: Vec<Vec<f64>>,
+    /// Per shape: whether it carries an annotation (a source).
+    pub sources: Vec<bool>,
+    /// Sweeps of the last run (the first pass counts as one).
+    pub sweeps: usize,
+    /// Whether the last sweep changed no label.
+    pub converged: bool,
+    /// Per shape: part index per vertex, `-1` unassigned.
+    state: Vec<Vec<i32>>,
+    /// Per shape: the annotation as part indices (`-1` = free), `None` for an unlabelled shape.
+    annotations: Vec<Option<Vec<i32>>>,
+    /// Cached vote of shape `j` on shape `i`: `(j, i) → d_i × P` column-major mean scores.
+    votes: BTreeMap<(usize, usize), Vec<f64>>,
+    /// Labels of `j` each cached vote was computed from.
+    vote_labels: BTreeMap<(usize, usize), Vec<i32>>,
+}
+
+/// Statistics of one [`Propagation::update`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct UpdateStats {
+    /// Shape re-scorings run.
+    pub shape_updates: usize,
+    /// Part transports through the band affinity computed (cached votes are reused).
+    pub transports: usize,
+}
+
+/// Carries part labels from the annotated shapes of `graph` to all of its shapes.
+///
+/// - `annotations[i]`: per-vertex labels of shape `i` (any integers, `< 0` = unlabelled;
+///   partial annotations allowed) or `None`. At least one shape must carry a label.
+/// - `smoothers`: one [`HeatSmoother`] per shape (graph order, time `options.smoothing_time`)
+///   for the boundary smoothing, or `None` to skip it.
+///
+/// Every annotated part is a fixed region on its source; its transport through the band
+/// affinity ([`region_scores`]: the mean affinity of each target vertex to the part) scores
+/// the target's vertices. Every source votes on every shape; shapes already labelled vote on
+/// their graph neighbours, weighted by their confidence, so labels reach shapes far from every
+/// source through intermediate ones. Scores are heat-smoothed, the part sizes are pulled toward
+/// the voters' area shares (`options.size_prior`), and every vertex takes its best part.
+/// Shapes are visited in order of graph distance from the sources, then in Gauss–Seidel
+/// sweeps until a sweep changes nothing: the fixed point of the thresholded transports with
+/// the sources held fixed. Annotated vertices keep their labels. Deterministic.
+///
+/// ```
+/// use coseg::bands::equal_count_bands;
+/// use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
+/// use coseg::propagate::{propagate_labels, PropagateOptions};
+/// let vals: Vec<f64> = (0..40).map(|v| v as f64).collect();
+/// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
+/// let nodes: Vec<ShapeNode> = (0..3)
+///     .map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &vec![1.0; 40]).unwrap())
+///     .collect();
+/// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
+/// let half: Vec<i32> = (0..40).map(|v| if v < 20 { 7 } else { 9 }).collect();
+/// let p = propagate_labels(&g, None, &[Some(half.clone()), None, None], &PropagateOptions::default()).unwrap();
+/// assert_eq!(p.labels[2], half); // identical shapes get the annotation
+/// ```
+pub fn propagate_labels(
+    graph: &ShapeGraph,
+    smoothers: Option<&[HeatSmoother]>,
+    annotations: &[Option<Vec<i32>>],
+    options: &PropagateOptions,
+) -> Result<Propagation, PropagateError> {
+    options.validate()?;
+    let n = graph.node_count();
+    if annotations.len() != n {
+        return Err(PropagateError::BadOption(format!(
+            "{} annotations for {n} shapes",
+            annotations.len()
+        )));
+    }
+    if let Some(s) = smoothers
+        && (s.len() != n || (0..n).any(|i| s[i].vertex_count() != graph.node(i).bands.vertices))
+    {
+        return Err(PropagateError::BadOption(
+            "one heat smoother per shape, with the shape's vertex count, is needed".into(),
+        ));
+    }
+    let mut parts: Vec<i32> = annotations
+        .iter()
+        .flatten()
+        .flat_map(|a| a.iter().copied().filter(|&l| l >= 0))
+        .collect();
+    parts.sort_unstable();
+    parts.dedup();
+    if parts.is_empty() {
+        return Err(PropagateError::NoLabels);
+    }
+    let mut p = Propagation {
+        parts: parts.clone(),
+        labels: Vec::new(),
+        confidence: (0..n)
+            .map(|i| vec![0.0; graph.node(i).bands.vertices])
+            .collect(),
+        shape_confidence: vec![0.0; n],
+        part_confidence: vec![vec![0.0; parts.len()]; n],
+        part_shares: vec![vec![0.0; parts.len()]; n],
+        sources: vec![false; n],
+        sweeps: 0,
+        converged: false,
+        state: (0..n)
+            .map(|i| vec![-1; graph.node(i).bands.vertices])
+            .collect(),
+        annotations: vec![None; n],
+        votes: BTreeMap::new(),
+        vote_labels: BTreeMap::new(),
+    };
+    for (i, a) in annotations.iter().enumerate() {
+        if let Some(a) = a {
+            p.set_annotation(graph, i, a)?;
+        }
+    }
+    p.run(graph, smoothers, options, None)?;
+    Ok(p)
+}
+
+impl Propagation {
+    fn set_annotation(
+        &mut self,
+        graph: &ShapeGraph,
+        i: usize,
+        labels: &[i32],
+    ) -> Result<(), PropagateError> {
+        let d = graph.node(i).bands.vertices;
+        if labels.len() != d {
+            return Err(PropagateError::Shape {
+                name: graph.node(i).name.clone(),
+                message: format!("{} labels for {d} vertices", labels.len()),
+            });
+        }
+        let idx: Vec<i32> = labels
+            .iter()
+            .map(|&l| {
+                if l < 0 {
+                    Ok(-1)
+                } else {
+                    self.parts
+                        .binary_search(&l)
+                        .map(|r| r as i32)
+                        .map_err(|_| PropagateError::Shape {
+                            name: graph.node(i).name.clone(),
+                            message: format!(
+                                "label {l} is not one of the parts {:?} (a new part needs a fresh propagate_labels)",
+                                self.parts
+                            ),
+                        })
+                }
+            })
+            .collect::<Result<_, _>>()?;
+        if idx.iter().all(|&l| l < 0) {
+            self.annotations[i] = None;
+            self.sources[i] = false;
+            return Ok(());
+        }
+        for (s, &a) in self.state[i].iter_mut().zip(&idx) {
+            if a >= 0 {
+                *s = a;
+            }
+        }
+        self.sources[i] = true;
+        self.annotations[i] = Some(idx);
+        Ok(())
+    }
+
+    /// Adds, corrects or removes (`labels = None`) the annotation of shape `i` and
+    /// re-propagates from the current state: shapes are re-scored only when a voter's labels
+    /// changed, and votes (transports) of unchanged voters are reused, so nothing per shape
+    /// (spectrum, features, bands, smoothers) is recomputed. Labels must be among
+    /// [`Propagation::parts`].
+    ///
+    /// ```
+    /// use coseg::bands::equal_count_bands;
+    /// use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
+    /// use coseg::propagate::{propagate_labels, PropagateOptions};
+    /// let vals: Vec<f64> = (0..40).map(|v| v as f64).collect();
+    /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
+    /// let nodes: Vec<ShapeNode> = (0..3)
+    ///     .map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &vec![1.0; 40]).unwrap())
+    ///     .collect();
+    /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
+    /// let half: Vec<i32> = (0..40).map(|v| if v < 20 { 0 } else { 1 }).collect();
+    /// let o = PropagateOptions::default();
+    /// let mut p = propagate_labels(&g, None, &[Some(half.clone()), None, None], &o).unwrap();
+    /// p.update(&g, None, 1, Some(half.clone()), &o).unwrap();
+    /// assert!(p.sources[1]);
+    /// assert_eq!(p.labels[2], half);
+    /// ```
+    pub fn update(
+        &mut self,
+        graph: &ShapeGraph,
+        smoothers: Option<&[HeatSmoother]>,
+        i: usize,
+        labels: Option<Vec<i32>>,
+        options: &PropagateOptions,
+    ) -> Result<UpdateStats, PropagateError> {
+        options.validate()?;
+        if i >= graph.node_count() || self.state.len() != graph.node_count() {
+            return Err(PropagateError::BadOption(format!(
+                "shape {i} is not in this propagation's graph"
+            )));
+        }
+        match labels {
+            Some(l) => self.set_annotation(graph, i, &l)?,
+            None => {
+                self.annotations[i] = None;
+                self.sources[i] = false;
+            }
+        }
+        if !self.sources.iter().any(|&s| s) {
+            return Err(PropagateError::NoLabels);
+        }
+        self.run(graph, smoothers, options, Some(i))
+    }
+
+    /// Who votes on shape `i`: every source but `i`, then `i`'s assigned graph neighbours that
+    /// are not sources; with their weights.
+    fn voters(
+        &self,
+        graph: &ShapeGraph,
+        i: usize,
+        options: &PropagateOptions,
+    ) -> Vec<(usize, f64)> {
+        let n = graph.node_count();
+        let mut out: Vec<(usize, f64)> = (0..n)
+            .filter(|&j| j != i && self.sources[j])
+            .map(|j| (j, 1.0))
+            .collect();
+        if options.network_weight > 0.0 {
+            let max_conf = (0..n)
+                .filter(|&j| !self.sources[j])
+                .map(|j| self.shape_confidence[j])
+                .fold(0.0, f64::max);
+            for (j, edge) in graph.neighbours(i) {
+                if self.sources[j] || self.state[j].iter().all(|&l| l < 0) || max_conf <= 0.0 {
+                    continue;
+                }
+                let c = options.network_weight * edge.weight * self.shape_confidence[j] / max_conf;
+                if c > 0.0 {
+                    out.push((j, c));
+                }
+            }
+        }
+        out
+    }
+
+    /// Labels shape `j` votes with: its annotation for a source, else its current state.
+    fn vote_source(&self, j: usize) -> &[i32] {
+        match &self.annotations[j] {
+            Some(a) if self.sources[j] => a,
+            _ => &self.state[j],
+        }
+    }
+
+    /// The vote of `j` on `i` (cached while `j`'s labels are unchanged); returns whether it
+    /// was computed.
+    fn ensure_vote(
+        &mut self,
+        graph: &ShapeGraph,
+        j: usize,
+        i: usize,
+    ) -> Result<bool, PropagateError> {
+        let src = self.vote_source(j);
+        if self
+            .vote_labels
+            .get(&(j, i))
+            .is_some_and(|l| l.as_slice() == src)
+        {
+            return Ok(false);
+        }
+        let src = src.to_vec();
+        let regions = self.parts.len();
+        let scores = match graph.affinity(j, i) {
+            Some(r) => {
+                let (w, dir) = r?;
+                region_scores(&w, dir, &src, regions, &mut w.workspace())?
+            }
+            None => {
+                let (lo, hi) = (j.min(i), j.max(i));
+                let (a, b) = (&graph.node(lo).bands, &graph.node(hi).bands);
+                let pairing = match graph.edges().first() {
+                    Some((_, _, e)) => e.pairing(),
+                    None => FeaturePairing::identity(a.features),
+                };
+                let w = BandAffinity::with_pairing(a, b, &pairing)?;
+                let dir = if j < i {
+                    Direction::AtoB
+                } else {
+                    Direction::BtoA
+                };
+                region_scores(&w, dir, &src, regions, &mut w.workspace())?
+            }
+        };
+        self.votes.insert((j, i), scores);
+        self.vote_labels.insert((j, i), src);
+        Ok(true)
+    }
+}
+
+/// Vote weights are rounded to this many steps per unit, so that a neighbour's small change
+/// of confidence does not force a re-score.
+const WEIGHT_STEPS: f64 = 16.0;
+
+impl Propagation {
+    /// Shapes in order of graph distance (edge summary distances) from the nearest source;
+    /// shapes the graph does not connect to a source come last, in index order.
+    fn order(&self, graph: &ShapeGraph) -> Vec<usize> {
+        let n = graph.node_count();
+        let mut dist = vec![f64::INFINITY; n];
+        let mut done = vec![false; n];
+        for (d, &s) in dist.iter_mut().zip(&self.sources) {
+            if s {
+                *d = 0.0;
+            }
+        }
+        let mut order = Vec::with_capacity(n);
+        for _ in 0..n {
+            let next = (0..n)
+                .filter(|&i| !done[i] && dist[i].is_finite())
+                .min_by(|&a, &b| dist[a].total_cmp(&dist[b]).then(a.cmp(&b)));
+            let Some(i) = next else { break };
+            done[i] = true;
+            order.push(i);
+            for (j, e) in graph.neighbours(i) {
+                let d = dist[i] + e.distance.max(0.0);
+                if d < dist[j] {
+                    dist[j] = d;
+                }
+            }
+        }
+        order.extend((0..n).filter(|&i| !done[i]));
+        order
+    }
+
+    fn run(
+        &mut self,
+        graph: &ShapeGraph,
+        smoothers: Option<&[HeatSmoother]>,
+        options: &PropagateOptions,
+        changed: Option<usize>,
+    ) -> Result<UpdateStats, PropagateError> {
+        let order = self.order(graph);
+        let mut stats = UpdateStats::default();
+        let mut last_voters: Vec<Option<Vec<(usize, f64)>>> = vec![None; graph.node_count()];
+        if let Some(c) = changed {
+            // The changed shape's own votes are stale whatever its labels are now.
+            self.vote_labels.retain(|&(j, _), _| j != c);
+        }
+        let (mut sweeps, mut converged) = (0, false);
+        while sweeps <= options.max_sweeps {
+            sweeps += 1;
+            let mut any = false;
+            for &i in &order {
+                if self.annotations[i]
+                    .as_ref()
+                    .is_some_and(|a| a.iter().all(|&l| l >= 0))
+                {
+                    continue;
+                }
+                let voters: Vec<(usize, f64)> = self
+                    .voters(graph, i, options)
+                    .into_iter()
+                    .map(|(j, c)| (j, (c * WEIGHT_STEPS).round() / WEIGHT_STEPS))
+                    .filter(|&(_, c)| c > 0.0)
+                    .collect();
+                let mut computed = 0;
+                for &(j, _) in &voters {
+                    if self.ensure_vote(graph, j, i)? {
+                        computed += 1;
+                    }
+                }
+                if computed == 0 && last_voters[i].as_ref() == Some(&voters) {
+                    continue;
+                }
+                stats.transports += computed * self.parts.len();
+                stats.shape_updates += 1;
+                let smoother = smoothers
+                    .filter(|_| options.smoothing_time > 0.0)
+                    .map(|s| &s[i]);
+                let (new, margin) = self.assign(graph, i, &voters, smoother, options)?;
+                last_voters[i] = Some(voters);
+                if new != self.state[i] {
+                    any = true;
+                    self.state[i] = new;
+                }
+                self.confidence[i] = margin;
+                self.update_stats(graph, i);
+            }
+            if !any {
+                converged = true;
+                break;
+            }
+        }
+        self.sweeps = sweeps;
+        self.converged = converged;
+        for i in 0..graph.node_count() {
+            self.update_stats(graph, i);
+        }
+        self.labels = self
+            .state
+            .iter()
+            .map(|s| {
+                s.iter()
+                    .map(|&r| if r >= 0 { self.parts[r as usize] } else { -1 })
+                    .collect()
+            })
+            .collect();
+        Ok(stats)
+    }
+
+    /// Scores of shape `i` from its voters, smoothed, sizes fitted, best part per vertex.
+    fn assign(
+        &self,
+        graph: &ShapeGraph,
+        i: usize,
+        voters: &[(usize, f64)],
+        smoother: Option<&HeatSmoother>,
+        options: &PropagateOptions,
+    ) -> Result<(Vec<i32>, Vec<f64>), PropagateError> {
+        let node = graph.node(i);
+        let (d, np) = (node.bands.vertices, self.parts.len());
+        let mut total = vec![0.0; d * np];
+        let mut wsum = vec![0.0; np];
+        let mut prior = vec![0.0; np];
+        for &(j, c) in voters {
+            let vote = &self.votes[&(j, i)];
+            let shares = part_shares(self.vote_source(j), &graph.node(j).areas, np);
+            for r in 0..np {
+                if shares[r] > 0.0 {
+                    wsum[r] += c;
+                    prior[r] += c * shares[r];
+                    let (t, v) = (&mut total[r * d..(r + 1) * d], &vote[r * d..(r + 1) * d]);
+                    t.par_iter_mut().zip(v).for_each(|(t, v)| *t += c * v);
+                }
+            }
+        }
+        for r in 0..np {
+            if wsum[r] > 0.0 {
+                total[r * d..(r + 1) * d]
+                    .iter_mut()
+                    .for_each(|t| *t /= wsum[r]);
+            }
+        }
+        let psum: f64 = prior.iter().sum();
+        if psum > 0.0 {
+            prior.iter_mut().for_each(|p| *p /= psum);
+        }
+        if let Some(s) = smoother {
+            s.smooth(&mut total, np)
+                .map_err(|e| PropagateError::Smoothing {
+                    name: node.name.clone(),
+                    message: e.to_string(),
+                })?;
+        }
+        let (mut labels, mut margins) =
+            fit_sizes(&total, np, &node.areas, &prior, options.size_prior);
+        if let Some(a) = &self.annotations[i] {
+            for v in 0..d {
+                if a[v] >= 0 {
+                    labels[v] = a[v];
+                    margins[v] = 1.0;
+                }
+            }
+        }
+        Ok((labels, margins))
+    }
+
+    fn update_stats(&mut self, graph: &ShapeGraph, i: usize) {
+        let areas = &graph.node(i).areas;
+        let np = self.parts.len();
+        let total: f64 = areas.iter().sum();
+        let (mut conf, mut share, mut all) = (vec![0.0; np], vec![0.0; np], 0.0);
+        for (v, &r) in self.state[i].iter().enumerate() {
+            let c = if self.annotations[i].as_ref().is_some_and(|a| a[v] >= 0) {
+                1.0
+            } else {
+                self.confidence[i][v]
+            };
+            self.confidence[i][v] = c;
+            all += areas[v] * c;
+            if r >= 0 {
+                conf[r as usize] += areas[v] * c;
+                share[r as usize] += areas[v];
+            }
+        }
+        for r in 0..np {
+            conf[r] = if share[r] > 0.0 {
+                conf[r] / share[r]
+            } else {
+                0.0
+            };
+            share[r] = if total > 0.0 { share[r] / total } else { 0.0 };
+        }
+        self.shape_confidence[i] = if total > 0.0 { all / total } else { 0.0 };
+        self.part_confidence[i] = conf;
+        self.part_shares[i] = share;
+    }
+}
+
+/// Area share of every part among the labelled area of one shape.
+fn part_shares(labels: &[i32], areas: &[f64], np: usize) -> Vec<f64> {
+    let mut s = vec![0.0; np];
+    for (&l, &a) in labels.iter().zip(areas) {
+        if l >= 0 && (l as usize) < np {
+            s[l as usize] += a;
+        }
+    }
+    let t: f64 = s.iter().sum();
+    if t > 0.0 {
+        s.iter_mut().for_each(|x| *x /= t);
+    }
+    s
+}
+
+/// Best part per vertex of `scores` (column-major `d × np`) scaled per part by factors fitted
+/// so that the parts' area shares approach `prior^α · plain^(1−α)` (`plain`: the shares of the
+/// unscaled assignment); returns labels and relative margins.
+fn fit_sizes(
+    scores: &[f64],
+    np: usize,
+    areas: &[f64],
+    prior: &[f64],
+    alpha: f64,
+) -> (Vec<i32>, Vec<f64>) {
+    let d = areas.len();
+    let total: f64 = areas.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+    let assign = |scale: &[f64]| -> (Vec<i32>, Vec<f64>, Vec<f64>) {
+        let mut labels = vec![0i32; d];
+        let mut margins = vec![0.0; d];
+        let mut shares = vec![0.0; np];
+        for q in 0..d {
+            let (mut best, mut second, mut arg) = (f64::NEG_INFINITY, f64::NEG_INFINITY, 0);
+            for r in 0..np {
+                let s = scores[r * d + q] * scale[r];
+                if s > best {
+                    second = best;
+                    best = s;
+                    arg = r;
+                } else if s > second {
+                    second = s;
+                }
+            }
+            labels[q] = arg as i32;
+            margins[q] = if best > 0.0 {
+                ((best - second.max(0.0)) / best).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            shares[arg] += areas[q] / total;
+        }
+        (labels, margins, shares)
+    };
+    let mut scale = vec![1.0; np];
+    let (labels, margins, plain) = assign(&scale);
+    if alpha <= 0.0 || np < 2 {
+        return (labels, margins);
+    }
+    let floor = 1e-4;
+    let mut target: Vec<f64> = (0..np)
+        .map(|r| prior[r].max(floor).powf(alpha) * plain[r].max(floor).powf(1.0 - alpha))
+        .collect();
+    let t: f64 = target.iter().sum();
+    target.iter_mut().for_each(|x| *x /= t);
+    let mut result = (labels, margins);
+    for _ in 0..40 {
+        let (l, m, shares) = assign(&scale);
+        result = (l, m);
+        let err = (0..np)
+            .map(|r| (shares[r] - target[r]).abs())
+            .fold(0.0, f64::max);
+        if err < 0.005 {
+            break;
+        }
+        for r in 0..np {
+            scale[r] *= (target[r] / shares[r].max(floor)).powf(0.25);
+        }
+        let m = scale.iter().copied().fold(0.0, f64::max);
+        scale.iter_mut().for_each(|s| *s /= m);
+    }
+    result
+}

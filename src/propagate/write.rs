@@ -1,0 +1,171 @@
+//! [`write_propagation`]: label files, coloured meshes and `summary.json` of a propagation.
+
+use super::{PropagateError, PropagateOptions, PropagatedCollection};
+use crate::graph::GraphOptions;
+use crate::labels::{LabelKind, vertices_to_faces, write_face_labels, write_vertex_labels};
+use crate::mesh::{PlyVertexProperty, write_mesh};
+use crate::output::{region_colors, write_summary};
+use serde::Serialize;
+use std::path::{Path, PathBuf};
+
+/// One part in `summary.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct PartSummary {
+    /// The label.
+    pub label: i32,
+    /// Its name from the part-names file, if any.
+    pub name: Option<String>,
+    /// Share of the shape's area (per shape) or mean share over shapes (collection).
+    pub area_fraction: f64,
+    /// Area-weighted mean per-vertex confidence over the part's vertices.
+    pub confidence: f64,
+}
+
+/// One shape in `summary.json`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ShapeSummary {
+    /// Output name (file stem).
+    pub name: String,
+    /// Input mesh file.
+    pub file: String,
+    /// Vertex count.
+    pub vertices: usize,
+    /// The annotation file when the shape is a source.
+    pub label_file: Option<String>,
+    /// `"vertex"` or `"face"` for a source.
+    pub label_kind: Option<LabelKind>,
+    /// Area-weighted mean per-vertex confidence.
+    pub confidence: f64,
+    /// Per part present in the collection.
+    pub parts: Vec<PartSummary>,
+}
+
+/// `summary.json` of `coseg propagate`: no timings, so reruns give the same bytes.
+#[derive(Debug, Clone, Serialize)]
+pub struct PropagationSummary {
+    /// Names of the source shapes.
+    pub sources: Vec<String>,
+    /// Every shape, graph order.
+    pub shapes: Vec<ShapeSummary>,
+    /// Every part over the collection (mean area share and confidence over the shapes).
+    pub parts: Vec<PartSummary>,
+    /// Sweeps of the solver and whether the last changed nothing.
+    pub sweeps: usize,
+    /// Whether the last sweep changed no label.
+    pub converged: bool,
+    /// Mesh files skipped, with the reason.
+    pub skipped: Vec<String>,
+    /// The solver's options.
+    pub options: PropagateOptions,
+    /// The graph's options.
+    pub graph: GraphOptions,
+}
+
+impl PropagationSummary {
+    /// The summary of `c`.
+    pub fn of(c: &PropagatedCollection, graph: &GraphOptions, options: &PropagateOptions) -> Self {
+        let p = &c.propagation;
+        let name_of = |l: i32| c.part_names.get(&l).cloned();
+        let n = c.graph.node_count();
+        let shapes: Vec<ShapeSummary> = (0..n)
+            .map(|i| {
+                let src = c.sources.iter().find(|s| s.shape == i);
+                ShapeSummary {
+                    name: c.graph.node(i).name.clone(),
+                    file: c.paths[i].display().to_string(),
+                    vertices: c.graph.node(i).bands.vertices,
+                    label_file: src.map(|s| s.path.display().to_string()),
+                    label_kind: src.map(|s| s.kind),
+                    confidence: p.shape_confidence[i],
+                    parts: p
+                        .parts
+                        .iter()
+                        .enumerate()
+                        .map(|(r, &l)| PartSummary {
+                            label: l,
+                            name: name_of(l),
+                            area_fraction: p.part_shares[i][r],
+                            confidence: p.part_confidence[i][r],
+                        })
+                        .collect(),
+                }
+            })
+            .collect();
+        let parts = p
+            .parts
+            .iter()
+            .enumerate()
+            .map(|(r, &l)| {
+                let present: Vec<usize> = (0..n).filter(|&i| p.part_shares[i][r] > 0.0).collect();
+                let k = present.len().max(1) as f64;
+                PartSummary {
+                    label: l,
+                    name: name_of(l),
+                    area_fraction: (0..n).map(|i| p.part_shares[i][r]).sum::<f64>() / n as f64,
+                    confidence: present
+                        .iter()
+                        .map(|&i| p.part_confidence[i][r])
+                        .sum::<f64>()
+                        / k,
+                }
+            })
+            .collect();
+        PropagationSummary {
+            sources: c
+                .sources
+                .iter()
+                .map(|s| c.graph.node(s.shape).name.clone())
+                .collect(),
+            shapes,
+            parts,
+            sweeps: p.sweeps,
+            converged: p.converged,
+            skipped: c
+                .skipped
+                .iter()
+                .map(|s| format!("{}: {}", s.path.display(), s.error))
+                .collect(),
+            options: options.clone(),
+            graph: *graph,
+        }
+    }
+}
+
+/// Writes into `dir` (created if missing), for every shape, `<name>.labels.txt` (per vertex),
+/// `<name>.seg` (per face, [`vertices_to_faces`]) and `<name>.labels.ply` (coloured by label,
+/// integer `label` vertex property), then `summary.json`. Every file is written atomically.
+/// Returns the written paths.
+pub fn write_propagation(
+    dir: &Path,
+    c: &PropagatedCollection,
+    summary: &PropagationSummary,
+) -> Result<Vec<PathBuf>, PropagateError> {
+    std::fs::create_dir_all(dir).map_err(|source| crate::output::OutputError::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let mut out = Vec::new();
+    for i in 0..c.graph.node_count() {
+        let name = &c.graph.node(i).name;
+        let labels = &c.propagation.labels[i];
+        out.push(write_vertex_labels(dir, name, labels)?);
+        out.push(write_face_labels(
+            dir,
+            name,
+            &vertices_to_faces(&c.meshes[i], labels)?,
+        )?);
+        let ply = dir.join(format!("{name}.labels.ply"));
+        write_mesh(
+            &ply,
+            &c.meshes[i],
+            &[
+                PlyVertexProperty::Color(region_colors(labels)),
+                PlyVertexProperty::Int("label".into(), labels.clone()),
+            ],
+        )
+        .map_err(crate::output::OutputError::from)?;
+        out.push(ply);
+    }
+    out.push(write_summary(dir, summary)?);
+    Ok(out)
+}
