@@ -100,9 +100,11 @@ enum Command {
     #[command(after_help = "Example:\n  coseg eval out/ --truth shapes/ --json scores.json")]
     Eval(eval::EvalArgs),
     /// Carry part labels from a few annotated meshes to every mesh of a folder.
-    #[command(after_help = "Example:\n  coseg propagate shapes/ --labels labelled/ -o out/\n\
+    #[command(
+        after_help = "Example:\n  coseg propagate shapes/ --labels labelled/ -o out/\n\
         Reads <stem>.seg (per face) or <stem>.labels.txt (per vertex) from --labels; writes \
-        out/<name>.labels.{txt,ply}, <name>.seg, summary.json.")]
+        out/<name>.labels.{txt,ply}, <name>.seg, summary.json."
+    )]
     Propagate(propagate::PropagateArgs),
 }
 

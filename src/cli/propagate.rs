@@ -4,10 +4,13 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::graph::GraphOptions;
+use coseg::labels::PartNames;
+use coseg::output::write_visuals;
 use coseg::propagate::{
     PropagateCollectionOptions, PropagateOptions, PropagationSummary, propagate_collection,
     write_propagation,
 };
+use coseg::render::{RenderOptions, RenderShape};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -25,9 +28,12 @@ pub struct PropagateArgs {
     /// `summary.json`.
     #[arg(short, long)]
     out: PathBuf,
-    /// Part names, a JSON object `{label: name}`, carried into summary.json.
+    /// Part names, a JSON object `{label: name}`, carried into summary.json and the pictures.
     #[arg(long)]
     part_names: Option<PathBuf>,
+    /// Do not write preview.png, <name>.png and index.html.
+    #[arg(long)]
+    no_pictures: bool,
     /// Per-shape cache folder (default: `<OUT>/.cache`).
     #[arg(long)]
     cache: Option<PathBuf>,
@@ -57,7 +63,7 @@ pub struct PropagateArgs {
 pub fn run(args: PropagateArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
     let mut options = PropagateCollectionOptions::default();
-    options.pipeline = args.pipeline.options();
+    options.pipeline = args.pipeline.options()?;
     options.graph.complete_limit = args.complete_limit;
     options.graph.neighbours = args.neighbours;
     options.propagate.smoothing_time = args.smoothing_time;
@@ -76,16 +82,45 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
         eprintln!("error: {} (skipped)", s.error);
     }
     for w in &result.warnings {
-        eprintln!("warning: {w}");
+        super::warn(w);
     }
+    super::check_strict(result.skipped.len())?;
     let n = result.graph.node_count();
     if n == 0 {
         bail!("{}: no readable mesh", args.folder.display());
     }
     let t_solve = t0.elapsed();
     let summary = PropagationSummary::of(&result, &options.graph, &options.propagate);
-    let written = write_propagation(&args.out, &result, &summary)?;
+    let mut written = write_propagation(&args.out, &result, &summary)?;
     let p = &result.propagation;
+    if !args.no_pictures {
+        let spin = super::spinner("pictures");
+        let pictures: Vec<RenderShape> = (0..n)
+            .map(|i| RenderShape {
+                name: &result.graph.node(i).name,
+                mesh: &result.meshes[i],
+                labels: &p.labels[i],
+                confidence: (!p.sources[i]).then_some(p.shape_confidence[i]),
+            })
+            .collect();
+        // The legends index names by label value; labels are the annotation's own integers.
+        let names = legend_names(&p.parts, &result.part_names);
+        written.extend(write_visuals(
+            &args.out,
+            &pictures,
+            (!result.part_names.is_empty()).then_some(names.as_slice()),
+            &RenderOptions::default(),
+        )?);
+        if let Some(b) = spin {
+            b.finish_and_clear();
+        }
+    }
+    if super::quiet() {
+        return Ok(super::exit_code(
+            result.skipped.len(),
+            n + result.skipped.len(),
+        ));
+    }
     println!(
         "{} shapes labelled from {} source(s) with {} parts ({} sweeps{}); {} files in {}",
         n,
@@ -115,4 +150,13 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
         result.skipped.len(),
         n + result.skipped.len(),
     ))
+}
+
+/// Legend text per label value `0..=max`: the part's name when given, else empty (the legend
+/// then shows the bare label).
+fn legend_names(parts: &[i32], names: &PartNames) -> Vec<String> {
+    let max = parts.iter().copied().max().unwrap_or(-1).max(-1);
+    (0..=max)
+        .map(|l| names.get(&l).cloned().unwrap_or_default())
+        .collect()
 }
