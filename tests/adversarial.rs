@@ -116,6 +116,24 @@ fn assert_no_nan(dir: &Path) {
                         path.display()
                     );
                 }
+                Some("png") => {
+                    // Pictures: a valid PNG is all there is to check (colours, not numbers).
+                    let file = std::fs::File::open(&path).unwrap();
+                    let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+                        .read_info()
+                        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+                    let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+                    reader.next_frame(&mut buf).unwrap();
+                }
+                Some("html") => {
+                    // The viewer page: its numbers are the JSON of the `coseg-data` script.
+                    let t = std::fs::read_to_string(&path).unwrap();
+                    let open = "<script id=\"coseg-data\" type=\"application/json\">";
+                    let start = t.find(open).expect("viewer data script") + open.len();
+                    let end = start + t[start..].find("</script>").unwrap();
+                    let v: serde_json::Value = serde_json::from_str(&t[start..end]).unwrap();
+                    check_json(&v, &path.display().to_string(), "");
+                }
                 Some("json") => {
                     let v: serde_json::Value =
                         serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();

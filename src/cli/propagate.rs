@@ -100,7 +100,7 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
                 name: &result.graph.node(i).name,
                 mesh: &result.meshes[i],
                 labels: &p.labels[i],
-                confidence: (!p.sources[i]).then_some(p.shape_confidence[i]),
+                confidence: Some(p.shape_confidence[i]),
             })
             .collect();
         // The legends index names by label value; labels are the annotation's own integers.
