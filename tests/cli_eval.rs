@@ -59,3 +59,69 @@ fn eval_scores_a_result_folder_against_vertex_and_face_ground_truth() {
         "{stdout}"
     );
 }
+
+/// `coseg propagate` then `coseg eval` on its folder: label results are scored as they are
+/// (no mapping), per shape exactly as `evaluate::vertex_label_agreement` scores them, the
+/// source flagged and left out of the mean; the pictures and the viewer are written.
+#[test]
+fn eval_scores_a_propagation_folder_and_leaves_the_source_out() {
+    let goblets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("collections/goblets");
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("out");
+    let run = Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .arg("propagate")
+        .arg(&goblets)
+        .arg("--labels")
+        .arg(goblets.join("goblets_00.labels.txt"))
+        .arg("-o")
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    for f in ["preview.png", "index.html", "goblets_02.png"] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    let json = dir.path().join("scores.json");
+    let eval = Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .arg("eval")
+        .arg(&out)
+        .arg("--truth")
+        .arg(&goblets)
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&eval.stdout);
+    assert!(
+        eval.status.success(),
+        "{stdout}{}",
+        String::from_utf8_lossy(&eval.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    assert_eq!(v["kind"], "labels");
+    let shapes = v["shapes"].as_array().unwrap();
+    assert_eq!(shapes.len(), 6);
+    assert_eq!(shapes[0]["name"], "goblets_00");
+    assert_eq!(shapes[0]["source"], true);
+    let mut sum = 0.0;
+    for (i, s) in shapes.iter().enumerate().skip(1) {
+        let name = format!("goblets_0{i}");
+        assert_eq!(s["name"], name.as_str());
+        assert_eq!(s["source"], false);
+        let mesh = coseg::mesh::read_mesh(goblets.join(format!("{name}.obj"))).unwrap();
+        let truth =
+            coseg::evaluate::read_labels(goblets.join(format!("{name}.labels.txt"))).unwrap();
+        let got = coseg::evaluate::read_labels(out.join(format!("{name}.labels.txt"))).unwrap();
+        let a = coseg::evaluate::vertex_label_agreement(&mesh, &truth, &got).unwrap();
+        assert_eq!(s["accuracy"].as_f64().unwrap(), a.accuracy, "{name}");
+        sum += a.accuracy;
+    }
+    let mean = v["accuracy"].as_f64().unwrap();
+    assert!((mean - sum / 5.0).abs() < 1e-12, "{mean} vs {}", sum / 5.0);
+    assert!(stdout.contains("(source)"), "{stdout}");
+}

@@ -261,9 +261,9 @@ fn segment_is_deterministic() {
     let (first, second) = (segment_run(), segment("segment_again"));
     assert_success(first);
     assert_success(&second);
-    // Six shapes × (regions.txt, regions.ply) + summary.json (which holds no timings or
-    // output paths, so it is byte-identical too).
-    assert_eq!(assert_same_files(&first.out, &second.out), 13);
+    // Six shapes × (regions.txt, regions.ply, png) + summary.json (which holds no timings or
+    // output paths, so it is byte-identical too) + preview.png + index.html.
+    assert_eq!(assert_same_files(&first.out, &second.out), 21);
 }
 
 #[test]
@@ -277,7 +277,8 @@ fn pair_is_deterministic() {
     let second = coseg(&["pair".as_ref(), &a, &b, "-o".as_ref(), &out]);
     assert_success(first);
     assert!(second.status.success());
-    assert_eq!(assert_same_files(&first.out, &out), 5);
+    // Two shapes × (regions.txt, regions.ply, png) + summary.json, preview.png, index.html.
+    assert_eq!(assert_same_files(&first.out, &out), 9);
 }
 
 #[test]

@@ -26,6 +26,7 @@
 //! assert!((part_coverage(&[shape]).unwrap() - 0.75).abs() < 1e-12);
 //! ```
 
+mod evaluate_folder;
 mod ground_truth;
 mod group_parts;
 mod label_agreement;
@@ -35,6 +36,10 @@ mod part_purity;
 mod rand_index;
 mod read_labels;
 
+pub use evaluate_folder::{
+    CorrespondenceMap, EvaluateFolderOptions, FolderScores, ResultKind, ShapeScores,
+    evaluate_folder,
+};
 pub use ground_truth::GroundTruth;
 pub use group_parts::{PartGroups, group_parts};
 pub use label_agreement::{

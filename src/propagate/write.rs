@@ -43,6 +43,10 @@ pub struct ShapeSummary {
 /// `summary.json` of `coseg propagate`: no timings, so reruns give the same bytes.
 #[derive(Debug, Clone, Serialize)]
 pub struct PropagationSummary {
+    /// Always `"propagate"`.
+    pub command: &'static str,
+    /// The coseg version that wrote the file.
+    pub version: &'static str,
     /// Names of the source shapes.
     pub sources: Vec<String>,
     /// Every shape, graph order.
@@ -111,6 +115,8 @@ impl PropagationSummary {
             })
             .collect();
         PropagationSummary {
+            command: "propagate",
+            version: env!("CARGO_PKG_VERSION"),
             sources: c
                 .sources
                 .iter()

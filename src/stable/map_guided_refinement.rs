@@ -33,7 +33,7 @@ use crate::spectral::HeatSmoother;
 /// use coseg::pipeline::{compute_shape_data, ShapePipelineOptions};
 /// use coseg::mesh::read_mesh;
 /// use coseg::spectral::HeatSmoother;
-/// use coseg::maps::{MapShape, PointMapOptions, ShapeGeometry};
+/// use coseg::maps::{MapGuidedOptions, ShapeGeometry};
 /// use coseg::stable::*;
 /// let (ma, mb) = (read_mesh("cat0.off")?, read_mesh("cat1.off")?);
 /// let pipe = ShapePipelineOptions::default();
