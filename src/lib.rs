@@ -45,3 +45,8 @@ pub mod shape_task;
 pub mod spectral;
 pub mod stable;
 mod vertex_sets;
+
+/// The README's Rust example, compiled as a doc test so that it cannot rot.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeDoctests;

@@ -12,7 +12,7 @@ use coseg::spectral::dense_spectrum;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
 
-/// Sequential oracle: the straightforward sort-and-cut of DESIGN.md §2.
+/// Sequential oracle: the straightforward sort-and-cut of docs/METHOD.md §2.
 fn oracle(values: &[f64], n: usize, d: usize, k: usize) -> Vec<u8> {
     let mut labels = vec![0u8; n * d];
     for f in 0..n {

@@ -8,7 +8,7 @@
 //!
 //! a transport plan between the uniform measures (rows sum to `1/d_b`, columns to `1/d_a` when
 //! `K` divides both vertex counts). [`BandAffinity`] applies `W x` and `Wᵀ y` in
-//! `O(N (d_a + d_b))` through per-feature band histograms (DESIGN §3); [`dense_affinity`] builds
+//! `O(N (d_a + d_b))` through per-feature band histograms (docs/METHOD.md §3); [`dense_affinity`] builds
 //! the dense matrix for tests on small shapes.
 
 mod band_affinity;

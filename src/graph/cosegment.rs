@@ -12,7 +12,7 @@
 //! rule `P_α` on the remaining vertices of shape `i` (`α` a fraction of the shape's total area,
 //! so every region has the same size on every shape, as the paper's "10 % cutoff").
 //!
-//! This is the simultaneous update of DESIGN §5. We solve it by Gauss–Seidel sweeps in the
+//! This is the simultaneous update of docs/METHOD.md §5. We solve it by Gauss–Seidel sweeps in the
 //! breadth-first order of a spanning tree rooted at the most central shape, always using the
 //! newest regions, until a whole sweep changes nothing. Why this design rather than covering the
 //! graph with cycles:

@@ -1,5 +1,5 @@
 //! Shape collections: the shape graph, the cycle solver and consistent co-segmentation of a
-//! whole collection (DESIGN §5).
+//! whole collection (docs/METHOD.md §5).
 //!
 //! - [`stable_cycle`]: fixed points of `P_0 ∘ W_{0,m−1} ∘ … ∘ P_1 ∘ W_10` around a cycle of any
 //!   length `m ≥ 2`; the 2-cycle is exactly Algorithm 1.

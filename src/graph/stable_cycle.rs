@@ -1,5 +1,5 @@
 //! [`stable_cycle`]: fixed points of `P_0 ∘ W_{0,m−1} ∘ … ∘ P_2 ∘ W_21 ∘ P_1 ∘ W_10` around a
-//! cycle of `m ≥ 2` shapes (DESIGN §5), Algorithm 1 generalised.
+//! cycle of `m ≥ 2` shapes (docs/METHOD.md §5), Algorithm 1 generalised.
 
 use super::GraphError;
 use crate::affinity::{AffinityWorkspace, BandAffinity, Direction};

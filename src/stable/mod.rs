@@ -1,5 +1,5 @@
 //! Stable region pairs between two shapes: thresholding functions and Algorithms 1–3 of the
-//! paper (DESIGN §4), on the never-dense affinity operator of [`crate::affinity`].
+//! paper (docs/METHOD.md §4), on the never-dense affinity operator of [`crate::affinity`].
 //!
 //! - [`threshold`]: `P_p`, `P_α`, `P[τ_t]` on a remaining subset.
 //! - [`stable_pair`]: Algorithm 1 (stable pair from an initial indicator).
