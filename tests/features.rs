@@ -6,10 +6,10 @@ mod common;
 use common::features::{blob, icosphere, permutation, permute_mesh, similarity, spearman};
 use coseg::bands::{BandOptions, band_table};
 use coseg::features::{
-    DescriptorOptions, ExportFormat, ExportOptions, SpectralBand, descriptors, export_features,
-    heat_kernel_signature, mean_curvature, multiscale_mean_curvature, scale_grid,
-    wave_kernel_signature,
+    DescriptorOptions, SpectralBand, descriptors, heat_kernel_signature, mean_curvature,
+    multiscale_mean_curvature, scale_grid, wave_kernel_signature,
 };
+use coseg::output::{ExportFormat, ExportOptions, export_features};
 use coseg::spectral::{Spectrum, dense_spectrum};
 
 fn small_opts() -> DescriptorOptions {

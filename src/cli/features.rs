@@ -1,8 +1,8 @@
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
 use coseg::cache::CacheOutcome;
-use coseg::features::{ExportFormat, ExportOptions, export_features};
 use coseg::mesh::read_mesh_with_report;
+use coseg::output::{ExportFormat, ExportOptions, export_features};
 use coseg::pipeline::{compute_shape_data, load_or_compute};
 use std::path::PathBuf;
 use std::process::ExitCode;

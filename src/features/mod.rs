@@ -18,7 +18,6 @@
 
 mod columns;
 mod descriptors;
-mod export;
 mod extrinsic;
 mod families;
 mod heat_kernel_signature;
@@ -32,7 +31,6 @@ mod wave_kernel_signature;
 
 pub use columns::FeatureColumns;
 pub use descriptors::{DescriptorOptions, Descriptors, FeatureKind, descriptors};
-pub use export::{ExportFormat, ExportOptions, export_features};
 pub use extrinsic::{
     Alignment, Axis, ExtrinsicOptions, Frame, extrinsic_features, height_directions, shape_frame,
 };

@@ -14,6 +14,7 @@
 //!   writes them and the viewer in one call.
 
 mod collection_summary;
+mod export_features;
 mod pair_summary;
 mod region_colors;
 mod viewer;
@@ -23,6 +24,7 @@ mod write_regions;
 pub use collection_summary::{
     CollectionEdge, CollectionRegion, CollectionShape, CollectionSummary, SkippedInput,
 };
+pub use export_features::{ExportFormat, ExportOptions, export_features};
 pub use pair_summary::{PairSummary, RegionSummary, ShapeSummary};
 pub use region_colors::region_colors;
 pub use viewer::write_viewer;
@@ -48,6 +50,9 @@ pub enum OutputError {
     /// Writing a mesh failed.
     #[error(transparent)]
     Mesh(#[from] crate::mesh::MeshError),
+    /// Arrays to be written together do not fit each other (a bug of the caller).
+    #[error("inconsistent tables: {0}")]
+    Inconsistent(String),
     /// The region ids do not match the mesh.
     #[error("{name}: {ids} region ids for a mesh of {vertices} vertices")]
     Length {

@@ -1,5 +1,6 @@
-use super::{Descriptors, FeatureError};
+use super::OutputError;
 use crate::bands::BandTable;
+use crate::features::Descriptors;
 use crate::mesh::write_atomic;
 use crate::spectral::Spectrum;
 use std::io::Write;
@@ -34,7 +35,7 @@ pub struct ExportOptions {
 ///
 /// ```no_run
 /// # fn f(d: &coseg::features::Descriptors, b: &coseg::bands::BandTable) {
-/// use coseg::features::{export_features, ExportOptions};
+/// use coseg::output::{export_features, ExportOptions};
 /// export_features(std::path::Path::new("out"), d, b, None, &ExportOptions::default()).unwrap();
 /// # }
 /// ```
@@ -44,24 +45,24 @@ pub fn export_features(
     bands: &BandTable,
     spectrum: Option<&Spectrum>,
     options: &ExportOptions,
-) -> Result<Vec<PathBuf>, FeatureError> {
+) -> Result<Vec<PathBuf>, OutputError> {
     let d = descriptors.vertices;
     let n = descriptors.feature_count();
     if bands.vertices != d || bands.features != n {
-        return Err(FeatureError::Inconsistent(format!(
+        return Err(OutputError::Inconsistent(format!(
             "descriptors are {d} vertices × {n} features, bands {} × {}",
             bands.vertices, bands.features
         )));
     }
-    std::fs::create_dir_all(dir).map_err(|source| FeatureError::Io {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
         path: dir.display().to_string(),
         source,
     })?;
     let names = descriptors.names();
     let mut written = Vec::new();
-    let mut put = |name: &str, bytes: Vec<u8>| -> Result<(), FeatureError> {
+    let mut put = |name: &str, bytes: Vec<u8>| -> Result<(), OutputError> {
         let path = dir.join(name);
-        write_atomic(&path, |w| w.write_all(&bytes)).map_err(|source| FeatureError::Io {
+        write_atomic(&path, |w| w.write_all(&bytes)).map_err(|source| OutputError::Io {
             path: path.display().to_string(),
             source,
         })?;
@@ -142,13 +143,10 @@ pub fn export_features(
     Ok(written)
 }
 
-fn npy<T: npyz::AutoSerialize + Copy>(
-    data: &[T],
-    shape: &[usize],
-) -> Result<Vec<u8>, FeatureError> {
+fn npy<T: npyz::AutoSerialize + Copy>(data: &[T], shape: &[usize]) -> Result<Vec<u8>, OutputError> {
     use npyz::WriterBuilder;
     let mut buf = Vec::new();
-    let io = |source| FeatureError::Io {
+    let io = |source| OutputError::Io {
         path: "<npy buffer>".into(),
         source,
     };
