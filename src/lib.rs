@@ -11,19 +11,19 @@
 //! |---|---|---|
 //! | meshes | [`mesh`] | validated triangle meshes, readers and writers (OBJ, OFF, PLY) |
 //! | spectrum | [`spectral`] | cotangent Laplacian, lumped mass, Laplace–Beltrami eigenpairs |
-//! | features | [`features`] | HKS, WKS and multiscale mean curvature per vertex |
+//! | features | [`features`] | per-vertex feature families: spectral (HKS, WKS, multiscale mean curvature), extrinsic heights, shape diameter, user columns |
 //! | bands | [`bands`] | per-feature rank bands stored as a compact `u8` table |
 //! | per-shape pipeline | [`pipeline`] | mesh → spectrum → features → bands once per shape, through [`cache`] (storage only); [`pipeline::load_shape`] is the one loader |
 //! | correspondence maps | [`maps`] | functional maps, ZoomOut, one-to-one matches, map presets |
 //! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
 //! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
-//! | output | [`output`] | region files, coloured meshes, summaries, the viewer page |
-//! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view) |
 //! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
 //! | propagation | [`propagate`] | part labels carried from annotated shapes to a collection |
+//! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view, the palette) |
+//! | output | [`output`] | region files, coloured meshes, summaries, feature export, the viewer page |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
-//! | evaluation | [`evaluate`] | purity and coverage of found regions against ground-truth parts |
+//! | evaluation | [`evaluate`] | scores against ground truth: accuracy, per-part IoU, Rand index, purity and coverage; whole result folders ([`evaluate::evaluate_folder`]) |
 //! | per-shape task | [`shape_task`] | the per-shape stage as bytes in, cache entry bytes out (for distributed engines) |
 #![deny(missing_docs)]
 

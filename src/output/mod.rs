@@ -16,17 +16,17 @@
 mod collection_summary;
 mod export_features;
 mod pair_summary;
-mod region_colors;
 mod viewer;
 mod visuals;
 mod write_regions;
 
+/// Re-exported from [`crate::render`], where the palette lives: PLY colours and pictures agree.
+pub use crate::render::region_colors;
 pub use collection_summary::{
     CollectionEdge, CollectionRegion, CollectionShape, CollectionSummary, SkippedInput,
 };
 pub use export_features::{ExportFormat, ExportOptions, export_features};
 pub use pair_summary::{PairSummary, RegionSummary, ShapeSummary};
-pub use region_colors::region_colors;
 pub use viewer::write_viewer;
 pub use visuals::write_visuals;
 pub use write_regions::{

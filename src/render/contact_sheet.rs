@@ -1,8 +1,8 @@
 //! [`render_sheet`], [`render_shape`] and [`write_pictures`]: labelled pictures of shapes.
 
+use super::region_colors;
 use super::{RenderError, RgbImage, canonical_frame, draw_mesh, draw_text, text_width, write_png};
 use crate::mesh::TriMesh;
-use crate::output::region_colors;
 use std::path::{Path, PathBuf};
 
 /// One shape to draw: a name, its mesh and one label per vertex (`-1` = none, grey).

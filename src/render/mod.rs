@@ -2,7 +2,7 @@
 //!
 //! Every shape is drawn from its [canonical view](canonical_frame): its principal axes, with a
 //! sign rule that depends only on the shape, so the same rule applies to every shape of a
-//! collection. Vertices are coloured by label with [`crate::output::region_colors`] (the
+//! collection. Vertices are coloured by label with [`region_colors`] (the
 //! colours of the coloured PLY files), so a part has one colour on every shape. Lighting is a
 //! two-sided head light (ambient + Lambert) on interpolated vertex normals; each pixel takes
 //! the colour of the nearest corner of its triangle, which keeps part boundaries crisp.
@@ -20,12 +20,14 @@ mod contact_sheet;
 mod font;
 mod png_io;
 mod rasterise;
+mod region_colors;
 
 pub use canonical_view::{ViewFrame, canonical_frame};
 pub use contact_sheet::{RenderOptions, RenderShape, render_shape, render_sheet, write_pictures};
 pub use font::{draw_text, text_width};
 pub use png_io::{encode_png, write_png};
 pub use rasterise::draw_mesh;
+pub use region_colors::region_colors;
 
 use thiserror::Error;
 

@@ -15,10 +15,12 @@
 //! - [`correspondence_ratio`]: quality against a ground-truth map (paper §7.2).
 
 mod correspondence_ratio;
+mod extraction;
 mod initial_indicator;
 mod map_guided_refinement;
 mod refine_partition;
 mod refine_regions;
+mod region_types;
 mod segment_pair;
 mod stable_pair;
 mod stable_pairs_auto;
@@ -35,6 +37,10 @@ pub use refine_partition::{
     RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
 };
 pub use refine_regions::refine_regions;
+pub use region_types::{
+    Algorithm, AreaReference, AutoThreshold, RegionPair, StableRegions, StableRegionsOptions,
+    TSearch,
+};
 pub use segment_pair::{
     PairShape, PairStage, PairTimes, SegmentPairOptions, SegmentedPair, StageFallback, segment_pair,
 };
@@ -43,10 +49,7 @@ pub use stable_pair::{
 };
 pub use stable_pairs_auto::stable_pairs_auto;
 pub use stable_pairs_fixed::stable_pairs_fixed;
-pub use stable_regions::{
-    Algorithm, AreaReference, AutoThreshold, RegionPair, StableRegions, StableRegionsOptions,
-    TSearch, stable_regions,
-};
+pub use stable_regions::stable_regions;
 pub use threshold::{Threshold, ThresholdScratch, threshold};
 
 use crate::affinity::AffinityError;

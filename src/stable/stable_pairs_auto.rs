@@ -1,7 +1,7 @@
 //! [`stable_pairs_auto`]: Algorithm 3, stable pairs with automatic thresholds.
 
-use super::stable_pairs_fixed::Extraction;
-use super::stable_regions::{AutoThreshold, StableRegions, StableRegionsOptions, TSearch};
+use super::extraction::Extraction;
+use super::region_types::{AutoThreshold, StableRegions, StableRegionsOptions, TSearch};
 use super::{StableError, StablePair, StablePairOptions, Threshold, initial_indicator};
 use crate::affinity::BandAffinity;
 
