@@ -67,19 +67,19 @@ pub struct PairArgs {
     #[arg(long, value_enum, default_value = "fixed")]
     algorithm: AlgorithmArg,
     /// Number of region pairs K (the last one is the leftovers).
-    #[arg(long, default_value_t = 10)]
+    #[arg(long, default_value_t = StableRegionsOptions::default().pairs)]
     pairs: usize,
     /// Algorithm 2's area cutoff α (fraction of each shape's total area per pair).
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = default_alpha())]
     alpha: f64,
     /// Algorithm 2: α is a fraction of the remaining area instead of the total.
     #[arg(long)]
     alpha_of_remaining: bool,
     /// Algorithm 3's step δt.
-    #[arg(long, default_value_t = 0.1)]
+    #[arg(long, default_value_t = StableRegionsOptions::default().delta_t)]
     delta_t: f64,
     /// Algorithm 3's largest t.
-    #[arg(long, default_value_t = 20.0)]
+    #[arg(long, default_value_t = StableRegionsOptions::default().t_max)]
     t_max: f64,
     /// Algorithm 3: step t linearly as the paper does (slower) instead of bisecting.
     #[arg(long)]
@@ -88,10 +88,10 @@ pub struct PairArgs {
     #[arg(long, value_enum, default_value = "random")]
     init: InitArg,
     /// Seed of the random initial indicators.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = StableRegionsOptions::default().seed)]
     seed: u64,
     /// Algorithm 1's iteration cap.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = StableRegionsOptions::default().max_iterations)]
     max_iterations: usize,
     /// Rounds of boundary refinement after the algorithm (smoothed best responses between the
     /// two partitions, see `coseg::stable::refine_regions`); 0 keeps the algorithm's raw
@@ -131,6 +131,46 @@ pub struct PairArgs {
     pipeline: super::pipeline_args::PipelineArgs,
 }
 
+/// Algorithm 2's default area cut-off α, as the library sets it.
+fn default_alpha() -> f64 {
+    match StableRegionsOptions::default().p {
+        Threshold::AreaFraction(a) => a,
+        _ => 0.1,
+    }
+}
+
+/// The algorithm's options the flags select.
+fn region_options(args: &PairArgs) -> StableRegionsOptions {
+    StableRegionsOptions {
+        algorithm: match args.algorithm {
+            AlgorithmArg::Fixed => Algorithm::Fixed,
+            AlgorithmArg::Auto => Algorithm::Auto,
+        },
+        pairs: args.pairs,
+        p: Threshold::AreaFraction(args.alpha),
+        q: Threshold::AreaFraction(args.alpha),
+        area_reference: if args.alpha_of_remaining {
+            AreaReference::Remaining
+        } else {
+            AreaReference::Total
+        },
+        delta_t: args.delta_t,
+        t_max: args.t_max,
+        t_search: if args.linear_t {
+            TSearch::Linear
+        } else {
+            TSearch::Bisect
+        },
+        init: match args.init {
+            InitArg::Extreme => Init::Extreme,
+            InitArg::Random => Init::Random,
+        },
+        seed: args.seed,
+        max_iterations: args.max_iterations,
+        ..Default::default()
+    }
+}
+
 fn stem(p: &Path) -> String {
     p.file_stem()
         .map_or_else(|| "shape".into(), |s| s.to_string_lossy().into_owned())
@@ -165,34 +205,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let options = StableRegionsOptions {
-        algorithm: match args.algorithm {
-            AlgorithmArg::Fixed => Algorithm::Fixed,
-            AlgorithmArg::Auto => Algorithm::Auto,
-        },
-        pairs: args.pairs,
-        p: Threshold::AreaFraction(args.alpha),
-        q: Threshold::AreaFraction(args.alpha),
-        area_reference: if args.alpha_of_remaining {
-            AreaReference::Remaining
-        } else {
-            AreaReference::Total
-        },
-        delta_t: args.delta_t,
-        t_max: args.t_max,
-        t_search: if args.linear_t {
-            TSearch::Linear
-        } else {
-            TSearch::Bisect
-        },
-        init: match args.init {
-            InitArg::Extreme => Init::Extreme,
-            InitArg::Random => Init::Random,
-        },
-        seed: args.seed,
-        max_iterations: args.max_iterations,
-        ..Default::default()
-    };
+    let options = region_options(&args);
     let (ma, da) = &loaded[0];
     let (mb, db) = &loaded[1];
     let refine = (args.refine_rounds > 0).then_some(RefineOptions {
@@ -353,4 +366,36 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         println!("pictures: {out}/preview.png; viewer: {out}/index.html");
     }
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        pair: PairArgs,
+    }
+
+    /// With no option given, `coseg pair` runs the library's defaults: the algorithm's
+    /// options, the refinement's, the map step's size and smoothing, the per-shape pipeline.
+    #[test]
+    fn default_flags_select_the_library_defaults() {
+        let w = Wrapper::try_parse_from(["coseg", "a.off", "b.off", "-o", "out"]).unwrap();
+        assert_eq!(region_options(&w.pair), StableRegionsOptions::default());
+        assert_eq!(
+            w.pair.pipeline.options().unwrap(),
+            coseg::pipeline::ShapePipelineOptions::default()
+        );
+        let refine = RefineOptions::default();
+        assert_eq!(w.pair.refine_rounds, refine.max_rounds);
+        assert_eq!(w.pair.smoothing_time, refine.smoothing_time);
+        assert_eq!(w.pair.map_size, ZoomOutOptions::default().final_size);
+        assert_eq!(
+            w.pair.map_smoothing_time,
+            MapGuidedOptions::default().smoothing_time
+        );
+    }
 }

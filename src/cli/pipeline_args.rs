@@ -2,25 +2,25 @@
 
 use clap::Args;
 use coseg::bands::BandWeighting;
-use coseg::features::{parse_alignment, parse_families, parse_family_weights};
+use coseg::features::{ExtrinsicOptions, parse_alignment, parse_families, parse_family_weights};
 use coseg::pipeline::ShapePipelineOptions;
 
 #[derive(Debug, Args)]
 pub struct PipelineArgs {
     /// Number of Laplace–Beltrami eigenpairs.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = ShapePipelineOptions::default().spectrum.eigenpairs)]
     eigenpairs: usize,
     /// Number of HKS features.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = ShapePipelineOptions::default().descriptors.hks_count)]
     hks: usize,
     /// Number of WKS features.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = ShapePipelineOptions::default().descriptors.wks_count)]
     wks: usize,
     /// Number of multiscale mean-curvature features.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = ShapePipelineOptions::default().descriptors.curvature_count)]
     curvature: usize,
     /// Number of bands K.
-    #[arg(long, default_value_t = 20)]
+    #[arg(long, default_value_t = ShapePipelineOptions::default().bands.bands)]
     bands: usize,
     /// Cut bands by equal area instead of equal vertex count.
     #[arg(long)]
@@ -34,7 +34,7 @@ pub struct PipelineArgs {
     #[arg(long, default_value = "y")]
     up: String,
     /// Number of height directions of the extrinsic family.
-    #[arg(long, default_value_t = 100)]
+    #[arg(long, default_value_t = ExtrinsicOptions::default().directions)]
     directions: usize,
     /// Family weights in the affinity, e.g. spectral=1,extrinsic=2 (a family's total share;
     /// default 1 each). Used by `coseg segment`; `coseg pair` weights every column equally.
@@ -66,5 +66,27 @@ impl PipelineArgs {
             opts.descriptors.curvature_count = 0;
         }
         Ok(opts)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Debug, Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        pipeline: PipelineArgs,
+    }
+
+    /// The flags' defaults are the library's: no flag given selects `ShapePipelineOptions::default()`.
+    #[test]
+    fn default_flags_select_the_library_defaults() {
+        let w = Wrapper::try_parse_from(["coseg"]).unwrap();
+        assert_eq!(
+            w.pipeline.options().unwrap(),
+            ShapePipelineOptions::default()
+        );
     }
 }

@@ -12,7 +12,7 @@ pub struct SpectrumArgs {
     /// Mesh file (.obj, .off, .ply).
     mesh: PathBuf,
     /// Number of eigenpairs.
-    #[arg(short = 'k', long, default_value_t = 200)]
+    #[arg(short = 'k', long, default_value_t = SpectrumOptions::default().eigenpairs)]
     eigenpairs: usize,
     /// Print a JSON object (eigenvalues, vertex count, original area, solver statistics).
     #[arg(long)]
@@ -27,7 +27,7 @@ pub struct SpectrumArgs {
     #[arg(long, default_value_t = SpectrumOptions::default().block_size)]
     block_size: usize,
     /// Seed of the Lanczos start block.
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = SpectrumOptions::default().seed)]
     seed: u64,
     /// Threads for the solver (0 = all of `--threads`, 1 = sequential).
     #[arg(long, default_value_t = SpectrumOptions::default().threads)]
