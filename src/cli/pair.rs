@@ -7,9 +7,11 @@ use coseg::maps::ZoomOutOptions;
 use coseg::maps::{
     MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
 };
+use coseg::mesh::TriMesh;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, write_visuals};
-use coseg::pipeline::{PipelineError, ShapeData, load_shape};
+use coseg::pipeline::{PipelineError, ShapeData, ShapePipelineOptions, load_shape};
 use coseg::render::{RenderOptions, RenderShape};
+use coseg::spectral::Spectrum;
 use coseg::stable::{
     Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
     StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
@@ -171,25 +173,19 @@ fn region_options(args: &PairArgs) -> StableRegionsOptions {
     }
 }
 
-fn stem(p: &Path) -> String {
-    p.file_stem()
-        .map_or_else(|| "shape".into(), |s| s.to_string_lossy().into_owned())
-}
-
-pub fn run(args: PairArgs) -> Result<ExitCode> {
-    let pipe = args.pipeline.options()?;
-    let cache = (!args.no_cache).then(|| {
-        args.cache
-            .clone()
-            .unwrap_or_else(|| args.output.join(".cache"))
-    });
+/// Both shapes through the per-shape pipeline (and the cache), warnings printed.
+fn load_pair(
+    args: &PairArgs,
+    pipe: &ShapePipelineOptions,
+    cache: Option<&Path>,
+) -> Result<Vec<(TriMesh, ShapeData)>> {
     let mut loaded = Vec::new();
     let bar = super::progress_bar(2);
     for path in [&args.a, &args.b] {
         if let Some(b) = &bar {
             b.set_message(format!("per-shape data: {}", path.display()));
         }
-        let shape = match load_shape::<ShapeData>(path, &pipe, cache.as_deref()) {
+        let shape = match load_shape::<ShapeData>(path, pipe, cache) {
             Ok(s) => s,
             Err(PipelineError::Mesh(e)) => return Err(e.into()),
             Err(e) => return Err(anyhow::Error::new(e).context(format!("{}", path.display()))),
@@ -205,15 +201,18 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     if let Some(b) = bar {
         b.finish_and_clear();
     }
-    let options = region_options(&args);
-    let (ma, da) = &loaded[0];
-    let (mb, db) = &loaded[1];
-    let refine = (args.refine_rounds > 0).then_some(RefineOptions {
-        max_rounds: args.refine_rounds,
-        smoothing_time: args.smoothing_time,
-    });
-    let choice = map_preset(&da.spectrum, &db.spectrum)
-        .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
+    Ok(loaded)
+}
+
+/// The map step's options: the preset `--map-preset` (or, with `auto`, the spectra) selects,
+/// with the flags' overrides; the automatic choice and the preset used.
+fn map_step(
+    args: &PairArgs,
+    a: &Spectrum,
+    b: &Spectrum,
+) -> Result<(Option<MapGuidedOptions>, PresetChoice, MapPreset)> {
+    let choice =
+        map_preset(a, b).with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
     let chosen = match (args.near_isometric, args.map_preset) {
         (true, _) | (false, MapPresetArg::NearIsometric) => MapPreset::NearIsometric,
         (false, MapPresetArg::General) => MapPreset::General,
@@ -232,6 +231,49 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         map_weight,
         smoothing_time: args.map_smoothing_time,
     });
+    Ok((map_guided, choice, chosen))
+}
+
+/// preview.png, the two <name>.png and index.html.
+fn draw(out: &Path, shapes: &[ShapeRegions]) -> Result<Vec<PathBuf>> {
+    let pictures: Vec<RenderShape> = shapes
+        .iter()
+        .map(|s| RenderShape {
+            name: s.name,
+            mesh: s.mesh,
+            labels: s.regions,
+            confidence: None,
+        })
+        .collect();
+    Ok(write_visuals(
+        out,
+        &pictures,
+        None,
+        &RenderOptions::default(),
+    )?)
+}
+
+fn stem(p: &Path) -> String {
+    p.file_stem()
+        .map_or_else(|| "shape".into(), |s| s.to_string_lossy().into_owned())
+}
+
+pub fn run(args: PairArgs) -> Result<ExitCode> {
+    let pipe = args.pipeline.options()?;
+    let cache = (!args.no_cache).then(|| {
+        args.cache
+            .clone()
+            .unwrap_or_else(|| args.output.join(".cache"))
+    });
+    let loaded = load_pair(&args, &pipe, cache.as_deref())?;
+    let options = region_options(&args);
+    let (ma, da) = &loaded[0];
+    let (mb, db) = &loaded[1];
+    let refine = (args.refine_rounds > 0).then_some(RefineOptions {
+        max_rounds: args.refine_rounds,
+        smoothing_time: args.smoothing_time,
+    });
+    let (map_guided, choice, chosen) = map_step(&args, &da.spectrum, &db.spectrum)?;
     let pair_options = SegmentPairOptions {
         regions: options,
         refine,
@@ -318,21 +360,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     ];
     let mut written = write_regions(&args.output, &shapes, &summary)?;
     if !args.no_pictures {
-        let pictures: Vec<RenderShape> = shapes
-            .iter()
-            .map(|s| RenderShape {
-                name: s.name,
-                mesh: s.mesh,
-                labels: s.regions,
-                confidence: None,
-            })
-            .collect();
-        written.extend(write_visuals(
-            &args.output,
-            &pictures,
-            None,
-            &RenderOptions::default(),
-        )?);
+        written.extend(draw(&args.output, &shapes)?);
     }
     if super::quiet() {
         return Ok(ExitCode::SUCCESS);

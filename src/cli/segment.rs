@@ -4,15 +4,16 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{
-    AdaptiveOptions, CosegmentOptions, GraphOptions, PartsReport, SegmentCollectionOptions,
-    load_collection, segment_collection,
+    AdaptiveOptions, CosegmentOptions, GraphOptions, LoadedCollection, PartsReport,
+    SegmentCollectionOptions, SegmentedCollection, load_collection, segment_collection,
 };
 use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
+use coseg::pipeline::ShapePipelineOptions;
 use coseg::render::{RenderOptions, RenderShape};
 use coseg::stable::RefineOptions;
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 #[derive(Debug, Args)]
 pub struct SegmentArgs {
@@ -119,36 +120,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             loaded.nodes.len()
         );
     }
-    let options = SegmentCollectionOptions {
-        graph: GraphOptions {
-            complete_limit: args.complete_limit,
-            neighbours: args.neighbours,
-            ..Default::default()
-        },
-        cosegment: CosegmentOptions {
-            regions: args.regions.unwrap_or(CosegmentOptions::default().regions),
-            area_fraction: args.area_fraction,
-            seed: args.seed,
-            ..Default::default()
-        },
-        refine: (args.refine_rounds > 0).then_some(RefineOptions {
-            max_rounds: args.refine_rounds,
-            smoothing_time: args.smoothing_time,
-        }),
-        feature_weights: pipeline.feature_weights(loaded.nodes[0].bands.features),
-        parts: args.parts.map(|p| {
-            let mut o = AdaptiveOptions::default();
-            if let PartsArg::Count(k) = p {
-                o.parts = Some(k);
-                o.max_parts = o.max_parts.max(k);
-            }
-            if let Some(r) = args.regions {
-                o.max_parts = r;
-            }
-            o.seed = args.seed;
-            o
-        }),
-    };
+    let options = collection_options(&args, &pipeline, &loaded);
     let spin = super::spinner("co-segmentation and refinement");
     let result = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?;
     if let Some(b) = spin {
@@ -195,51 +167,117 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         .collect();
     let mut written = write_regions(&args.out, &shapes, &summary)?;
     if !args.no_pictures {
-        let spin = super::spinner("pictures");
-        let pictures: Vec<RenderShape> = shapes
-            .iter()
-            .map(|s| RenderShape {
-                name: s.name,
-                mesh: s.mesh,
-                labels: s.regions,
-                confidence: None,
-            })
-            .collect();
-        let names: Vec<String> = summary
-            .regions
-            .iter()
-            .map(|r| {
-                if r.leftover {
-                    "leftovers".to_string()
-                } else {
-                    format!("({:.0}%)", 100.0 * r.confidence)
-                }
-            })
-            .collect();
-        written.extend(write_visuals(
-            &args.out,
-            &pictures,
-            Some(&names),
-            &RenderOptions::default(),
-        )?);
-        if let Some(b) = spin {
-            b.finish_and_clear();
-        }
+        written.extend(draw(&args.out, &shapes, &summary)?);
     }
     let write_time = t_write.elapsed();
+    if !super::quiet() {
+        report(
+            &args,
+            &loaded,
+            &result,
+            &options,
+            written.len(),
+            write_time,
+            t0,
+        );
+    }
+    Ok(super::exit_code(loaded.skipped.len(), total_files))
+}
+
+/// The collection stage's options the flags select.
+fn collection_options(
+    args: &SegmentArgs,
+    pipeline: &ShapePipelineOptions,
+    loaded: &LoadedCollection,
+) -> SegmentCollectionOptions {
+    SegmentCollectionOptions {
+        graph: GraphOptions {
+            complete_limit: args.complete_limit,
+            neighbours: args.neighbours,
+            ..Default::default()
+        },
+        cosegment: CosegmentOptions {
+            regions: args.regions.unwrap_or(CosegmentOptions::default().regions),
+            area_fraction: args.area_fraction,
+            seed: args.seed,
+            ..Default::default()
+        },
+        refine: (args.refine_rounds > 0).then_some(RefineOptions {
+            max_rounds: args.refine_rounds,
+            smoothing_time: args.smoothing_time,
+        }),
+        feature_weights: pipeline.feature_weights(loaded.nodes[0].bands.features),
+        parts: args.parts.map(|p| {
+            let mut o = AdaptiveOptions::default();
+            if let PartsArg::Count(k) = p {
+                o.parts = Some(k);
+                o.max_parts = o.max_parts.max(k);
+            }
+            if let Some(r) = args.regions {
+                o.max_parts = r;
+            }
+            o.seed = args.seed;
+            o
+        }),
+    }
+}
+
+/// preview.png, <name>.png and index.html, legends naming each region by its confidence.
+fn draw(
+    out: &std::path::Path,
+    shapes: &[ShapeRegions],
+    summary: &CollectionSummary,
+) -> Result<Vec<PathBuf>> {
+    let spin = super::spinner("pictures");
+    let pictures: Vec<RenderShape> = shapes
+        .iter()
+        .map(|s| RenderShape {
+            name: s.name,
+            mesh: s.mesh,
+            labels: s.regions,
+            confidence: None,
+        })
+        .collect();
+    let names: Vec<String> = summary
+        .regions
+        .iter()
+        .map(|r| {
+            if r.leftover {
+                "leftovers".to_string()
+            } else {
+                format!("({:.0}%)", 100.0 * r.confidence)
+            }
+        })
+        .collect();
+    let paths = write_visuals(out, &pictures, Some(&names), &RenderOptions::default())?;
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
+    Ok(paths)
+}
+
+/// The one-screen summary on stdout: shapes, regions, times, where the results are.
+fn report(
+    args: &SegmentArgs,
+    loaded: &LoadedCollection,
+    result: &SegmentedCollection,
+    options: &SegmentCollectionOptions,
+    written: usize,
+    write_time: Duration,
+    t0: Instant,
+) {
+    let seg = &result.segmentation;
+    let total_files = loaded.nodes.len() + loaded.skipped.len();
     let hits = loaded
         .outcomes
         .iter()
         .filter(|o| **o == CacheOutcome::Hit)
         .count();
-    if super::quiet() {
-        return Ok(super::exit_code(loaded.skipped.len(), total_files));
-    }
     println!(
         "{} shapes co-segmented into {} regions; {} files in {}",
         loaded.nodes.len(),
         seg.tuples.len(),
-        written.len(),
+        written,
         args.out.display()
     );
     let times = &result.times;
@@ -275,5 +313,4 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             "results: {out}/summary.json; pictures: {out}/preview.png; viewer: {out}/index.html"
         );
     }
-    Ok(super::exit_code(loaded.skipped.len(), total_files))
 }

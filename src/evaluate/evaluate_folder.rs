@@ -158,81 +158,99 @@ pub fn evaluate_folder(
         }
     };
     match kind {
-        ResultKind::Regions => {
-            let pairs: Vec<(Vec<i32>, Vec<i32>)> = shapes
-                .iter()
-                .map(|(_, found, t)| (found.clone(), t.vertices.clone()))
-                .collect();
-            let m = matched_scores(&pairs)?;
-            let per_shape: Vec<ShapeScores> = names
-                .iter()
-                .zip(&m.per_shape)
-                .map(|(name, &(accuracy, rand_index))| ShapeScores {
-                    name: name.clone(),
-                    source: false,
-                    accuracy,
-                    rand_index,
-                    mean_iou: None,
-                })
-                .collect();
-            Ok(FolderScores {
-                kind,
-                mean_rand_index: mean(per_shape.iter().map(|s| s.rand_index)),
-                shapes: per_shape,
-                accuracy: m.accuracy,
-                part_iou: m.part_iou,
-                mean_iou: m.mean_iou,
-                mapping: m.mapping,
-                correspondence_ratio,
-            })
-        }
-        ResultKind::Labels => {
-            let mut per_shape = Vec::with_capacity(shapes.len());
-            let mut ious: BTreeMap<i32, Vec<f64>> = BTreeMap::new();
-            for (name, found, t) in &shapes {
-                let a = t.agreement(found).map_err(|e| rename(e, name))?;
-                let source = sources.contains(name);
-                if !source {
-                    let true_labels: Vec<i32> = t.labels().into_iter().collect();
-                    for p in a.parts.iter().filter(|p| true_labels.contains(&p.label)) {
-                        ious.entry(p.label).or_default().push(p.iou);
-                    }
-                }
-                let truth_v = &t.vertices;
-                let scored: Vec<usize> = (0..truth_v.len()).filter(|&v| truth_v[v] >= 0).collect();
-                let fv: Vec<i32> = scored.iter().map(|&v| found[v]).collect();
-                let tv: Vec<i32> = scored.iter().map(|&v| truth_v[v]).collect();
-                per_shape.push(ShapeScores {
-                    name: name.clone(),
-                    source,
-                    accuracy: a.accuracy,
-                    rand_index: super::rand_index(&fv, &tv).map_err(|e| rename(e, name))?,
-                    mean_iou: Some(a.mean_iou),
-                });
-            }
-            let scored: Vec<&ShapeScores> = per_shape.iter().filter(|s| !s.source).collect();
-            if scored.is_empty() {
-                return Err(EvaluateError::Empty(format!(
-                    "{}: every shape is a source",
-                    result.display()
-                )));
-            }
-            let part_iou: BTreeMap<i32, f64> = ious
-                .into_iter()
-                .map(|(l, v)| (l, mean(v.into_iter())))
-                .collect();
-            Ok(FolderScores {
-                kind,
-                accuracy: mean(scored.iter().map(|s| s.accuracy)),
-                mean_rand_index: mean(scored.iter().map(|s| s.rand_index)),
-                mean_iou: mean(part_iou.values().copied()),
-                part_iou,
-                shapes: per_shape,
-                mapping: BTreeMap::new(),
-                correspondence_ratio,
-            })
-        }
+        ResultKind::Regions => score_regions(&names, &shapes, correspondence_ratio),
+        ResultKind::Labels => score_labels(result, &sources, &shapes, correspondence_ratio),
     }
+}
+
+/// One shape's result and truth: its name, the found ids or labels per vertex, the truth.
+type Scored = (String, Vec<i32>, Truth);
+
+/// Region ids mapped to parts over the whole set ([`matched_scores`]).
+fn score_regions(
+    names: &[String],
+    shapes: &[Scored],
+    correspondence_ratio: Option<f64>,
+) -> Result<FolderScores, EvaluateError> {
+    let pairs: Vec<(Vec<i32>, Vec<i32>)> = shapes
+        .iter()
+        .map(|(_, found, t)| (found.clone(), t.vertices.clone()))
+        .collect();
+    let m = matched_scores(&pairs)?;
+    let per_shape: Vec<ShapeScores> = names
+        .iter()
+        .zip(&m.per_shape)
+        .map(|(name, &(accuracy, rand_index))| ShapeScores {
+            name: name.clone(),
+            source: false,
+            accuracy,
+            rand_index,
+            mean_iou: None,
+        })
+        .collect();
+    Ok(FolderScores {
+        kind: ResultKind::Regions,
+        mean_rand_index: mean(per_shape.iter().map(|s| s.rand_index)),
+        shapes: per_shape,
+        accuracy: m.accuracy,
+        part_iou: m.part_iou,
+        mean_iou: m.mean_iou,
+        mapping: m.mapping,
+        correspondence_ratio,
+    })
+}
+
+/// Labels compared as they are, per shape ([`label_agreement`]); sources left out of the means.
+fn score_labels(
+    result: &Path,
+    sources: &[String],
+    shapes: &[Scored],
+    correspondence_ratio: Option<f64>,
+) -> Result<FolderScores, EvaluateError> {
+    let mut per_shape = Vec::with_capacity(shapes.len());
+    let mut ious: BTreeMap<i32, Vec<f64>> = BTreeMap::new();
+    for (name, found, t) in shapes {
+        let a = t.agreement(found).map_err(|e| rename(e, name))?;
+        let source = sources.contains(name);
+        if !source {
+            let true_labels = t.labels();
+            for p in a.parts.iter().filter(|p| true_labels.contains(&p.label)) {
+                ious.entry(p.label).or_default().push(p.iou);
+            }
+        }
+        let truth_v = &t.vertices;
+        let scored: Vec<usize> = (0..truth_v.len()).filter(|&v| truth_v[v] >= 0).collect();
+        let fv: Vec<i32> = scored.iter().map(|&v| found[v]).collect();
+        let tv: Vec<i32> = scored.iter().map(|&v| truth_v[v]).collect();
+        per_shape.push(ShapeScores {
+            name: name.clone(),
+            source,
+            accuracy: a.accuracy,
+            rand_index: super::rand_index(&fv, &tv).map_err(|e| rename(e, name))?,
+            mean_iou: Some(a.mean_iou),
+        });
+    }
+    let scored: Vec<&ShapeScores> = per_shape.iter().filter(|s| !s.source).collect();
+    if scored.is_empty() {
+        return Err(EvaluateError::Empty(format!(
+            "{}: every shape is a source",
+            result.display()
+        )));
+    }
+    let part_iou: BTreeMap<i32, f64> = ious
+        .into_iter()
+        .map(|(l, v)| (l, mean(v.into_iter())))
+        .collect();
+    Ok(FolderScores {
+        kind: ResultKind::Labels,
+        accuracy: mean(scored.iter().map(|s| s.accuracy)),
+        mean_rand_index: mean(scored.iter().map(|s| s.rand_index)),
+        mean_iou: mean(part_iou.values().copied()),
+        part_iou,
+        shapes: per_shape,
+        mapping: BTreeMap::new(),
+        correspondence_ratio,
+    })
 }
 
 /// Ground truth of one shape: per vertex always; per face too when it came from a `.seg` file.
