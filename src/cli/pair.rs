@@ -236,15 +236,7 @@ fn map_step(
 
 /// preview.png, the two <name>.png and index.html.
 fn draw(out: &Path, shapes: &[ShapeRegions]) -> Result<Vec<PathBuf>> {
-    let pictures: Vec<RenderShape> = shapes
-        .iter()
-        .map(|s| RenderShape {
-            name: s.name,
-            mesh: s.mesh,
-            labels: s.regions,
-            confidence: None,
-        })
-        .collect();
+    let pictures: Vec<RenderShape> = shapes.iter().map(ShapeRegions::picture).collect();
     Ok(write_visuals(
         out,
         &pictures,

@@ -229,15 +229,7 @@ fn draw(
     summary: &CollectionSummary,
 ) -> Result<Vec<PathBuf>> {
     let spin = super::spinner("pictures");
-    let pictures: Vec<RenderShape> = shapes
-        .iter()
-        .map(|s| RenderShape {
-            name: s.name,
-            mesh: s.mesh,
-            labels: s.regions,
-            confidence: None,
-        })
-        .collect();
+    let pictures: Vec<RenderShape> = shapes.iter().map(ShapeRegions::picture).collect();
     let names: Vec<String> = summary
         .regions
         .iter()

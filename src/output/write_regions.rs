@@ -16,6 +16,18 @@ pub struct ShapeRegions<'a> {
     pub regions: &'a [i32],
 }
 
+impl<'a> ShapeRegions<'a> {
+    /// The shape as the pictures draw it (coloured by region, no confidence).
+    pub fn picture(&self) -> crate::render::RenderShape<'a> {
+        crate::render::RenderShape {
+            name: self.name,
+            mesh: self.mesh,
+            labels: self.regions,
+            confidence: None,
+        }
+    }
+}
+
 fn check_name(name: &str) -> Result<(), OutputError> {
     if name.is_empty() || name.contains(['/', '\\']) || name == "." || name == ".." {
         return Err(OutputError::BadName(name.to_string()));
