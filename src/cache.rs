@@ -195,13 +195,39 @@ pub fn decode_entry<T: DeserializeOwned>(
 ) -> Result<T, String> {
     let payload = unframe(bytes, kind.magic(), key)?;
     let (data, used): (T, usize) =
-        bincode::serde::decode_from_slice(payload, bincode::config::standard())
-            .map_err(|e| format!("payload does not decode ({e})"))?;
+        decode_payload(payload).map_err(|e| format!("payload does not decode ({e})"))?;
     if used != payload.len() {
         return Err("payload has trailing bytes".into());
     }
     check(&data)?;
     Ok(data)
+}
+
+/// Decodes a bincode payload with a memory limit proportional to its size.
+///
+/// bincode allocates a string or byte vector of the length its prefix declares before reading
+/// it, so a payload declaring a 2⁵⁶-byte string made the process abort on the allocation
+/// (found by the `cache_entry` fuzz target; regression test
+/// `tests/cache.rs::a_cache_entry_declaring_a_huge_string_is_refused_not_an_abort`). The limit
+/// counts the in-memory bytes of every decoded value (at most 16 per encoded byte: a `u128`
+/// in one varint byte), so 16 × the payload length never refuses a payload coseg wrote; it is
+/// rounded up to a power of 4 (the limit is a const parameter of bincode's configuration), so
+/// decoding allocates at most 64 × the payload's size.
+fn decode_payload<T: DeserializeOwned>(
+    payload: &[u8],
+) -> Result<(T, usize), bincode::error::DecodeError> {
+    let need = payload.len().saturating_mul(16);
+    macro_rules! tiers {
+        ($($bits:literal)*) => {$(
+            if need <= 1usize << $bits {
+                let config = bincode::config::standard().with_limit::<{ 1usize << $bits }>();
+                return bincode::serde::decode_from_slice(payload, config);
+            }
+        )*};
+    }
+    tiers!(12 14 16 18 20 22 24 26 28 30 32 34 36 38 40 42 44 46);
+    // Payloads over 4 TiB: no limit left to set below the address space.
+    bincode::serde::decode_from_slice(payload, bincode::config::standard())
 }
 
 /// The bytes of an entry of `kind` holding `value` under `key` (header + payload, see the

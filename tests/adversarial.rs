@@ -279,11 +279,11 @@ fn run_all(case: &Case, root: &Path, partner: &Path) -> Vec<(String, Verdict)> {
     let sdir = dir.join("segment");
     let mut args: Vec<std::ffi::OsString> = vec![
         "segment".into(),
-        folder.into(),
+        folder.clone().into(),
         "-o".into(),
         sdir.clone().into(),
         "--cache".into(),
-        cache.into(),
+        cache.clone().into(),
         "--regions".into(),
         "3".into(),
         "--refine-rounds".into(),
@@ -291,7 +291,119 @@ fn run_all(case: &Case, root: &Path, partner: &Path) -> Vec<(String, Verdict)> {
     ];
     args.extend(PIPE.iter().map(Into::into));
     record("segment", coseg(&args), Some(&sdir));
+
+    // propagate, both ways over the same folder: from a clean sphere's per-vertex labels onto
+    // the case (a labels folder, matched by stem), and from the case's per-face `.seg` onto
+    // the spheres (a file).
+    let stem = file.split('.').next().unwrap();
+    let from_sphere = dir.join("labels_sphere");
+    std::fs::create_dir_all(&from_sphere).unwrap();
+    let sphere = read_mesh(folder.join("sphere11.off")).unwrap();
+    write_lines(
+        &from_sphere.join("sphere11.labels.txt"),
+        &sphere_vertex_labels(&sphere),
+    );
+    let from_case = dir.join("labels_case");
+    std::fs::create_dir_all(&from_case).unwrap();
+    let case_mesh = read_mesh(&mesh).unwrap();
+    let seg = from_case.join(format!("{stem}.seg"));
+    write_lines(&seg, &case_face_labels(&case_mesh));
+    for (what, labels, parts) in [
+        ("propagate from a sphere", &from_sphere, &[1, 2][..]),
+        ("propagate from the case", &seg, &[3, 4][..]),
+    ] {
+        let pdir = dir.join(what.replace(' ', "_"));
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "propagate".into(),
+            folder.clone().into(),
+            "--labels".into(),
+            labels.into(),
+            "-o".into(),
+            pdir.clone().into(),
+            "--cache".into(),
+            cache.clone().into(),
+        ];
+        args.extend(PIPE.iter().map(Into::into));
+        let o = coseg(&args);
+        let ok = matches!(o.status.code(), Some(0) | Some(3));
+        record(what, o, Some(&pdir));
+        if ok {
+            check_propagated(&pdir, &folder, parts);
+        }
+    }
     out
+}
+
+/// Writes one integer per line.
+fn write_lines(path: &Path, labels: &[i32]) {
+    let text: String = labels.iter().map(|l| format!("{l}\n")).collect();
+    std::fs::write(path, text).unwrap();
+}
+
+/// Per-vertex labels of a clean sphere: 1 above z = 0.15, 2 below -0.15, unlabelled (-1 or
+/// another negative value, which means the same) between.
+fn sphere_vertex_labels(m: &TriMesh) -> Vec<i32> {
+    m.positions()
+        .iter()
+        .enumerate()
+        .map(|(i, p)| match p[2] {
+            z if z > 0.15 => 1,
+            z if z < -0.15 => 2,
+            _ if i % 2 == 0 => -1,
+            _ => -7,
+        })
+        .collect()
+}
+
+/// Per-face labels of a corpus mesh: 3 or 4 by the side of its face centroid against the
+/// mean of the centroids along x (at least one face 3), every fifth face unlabelled.
+fn case_face_labels(m: &TriMesh) -> Vec<i32> {
+    let p = m.positions();
+    let cx: Vec<f64> = m
+        .faces()
+        .iter()
+        .map(|f| f.iter().map(|&v| p[v as usize][0]).sum::<f64>() / 3.0)
+        .collect();
+    let mean = cx.iter().sum::<f64>() / cx.len() as f64;
+    cx.iter()
+        .enumerate()
+        .map(|(f, &x)| match f {
+            0 => 3,
+            _ if f % 5 == 4 => -1,
+            _ if x < mean => 3,
+            _ => 4,
+        })
+        .collect()
+}
+
+/// `coseg propagate`'s outputs in `out` for the meshes of `folder`: for every mesh a
+/// `.labels.txt` of one label per vertex and a `.seg` of one per face, each label a part of
+/// the sources (`parts`) or -1; `summary.json`, `index.html` and the pictures are there (their
+/// finiteness is [`assert_no_nan`]'s).
+fn check_propagated(out: &Path, folder: &Path, parts: &[i32]) {
+    let read = |p: PathBuf| -> Vec<i32> {
+        std::fs::read_to_string(&p)
+            .unwrap_or_else(|e| panic!("{}: {e}", p.display()))
+            .lines()
+            .map(|l| l.parse().unwrap())
+            .collect()
+    };
+    for entry in std::fs::read_dir(folder).unwrap() {
+        let path = entry.unwrap().path();
+        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
+        let m = read_mesh(&path).unwrap();
+        let v = read(out.join(format!("{stem}.labels.txt")));
+        let f = read(out.join(format!("{stem}.seg")));
+        assert_eq!(v.len(), m.vertex_count(), "{stem}.labels.txt");
+        assert_eq!(f.len(), m.face_count(), "{stem}.seg");
+        for l in v.iter().chain(&f) {
+            assert!(*l == -1 || parts.contains(l), "{stem}: label {l}");
+        }
+        assert!(v.iter().any(|l| parts.contains(l)), "{stem}: no part");
+    }
+    for name in ["summary.json", "index.html", "preview.png"] {
+        assert!(out.join(name).is_file(), "{}: no {name}", out.display());
+    }
 }
 
 /// The whole corpus through every command. Every case must succeed on every command: each
@@ -568,4 +680,167 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
     let mut bad = options;
     bad.map_guided.as_mut().unwrap().map_weight = f64::NAN;
     assert!(segment_pair(shape(0), shape(1), &bad).is_err());
+}
+
+/// `coseg propagate` refuses a label file that does not fit its mesh, with exit code 1 and a
+/// message naming the file and the reason, and writes no output: wrong length (per vertex and
+/// per face), a line that is not an integer, an empty file, bytes that are not text, a label
+/// out of range, only unlabelled lines, and label inputs that match no mesh.
+#[test]
+fn propagate_refuses_bad_label_files_naming_them() {
+    let dir = scratch("bad_labels");
+    let folder = dir.join("meshes");
+    std::fs::create_dir_all(&folder).unwrap();
+    for seed in [1, 2, 3] {
+        let (p, f) = base_sphere(seed);
+        write_mesh(
+            folder.join(format!("s{seed}.off")),
+            &TriMesh::new(p, f).unwrap(),
+            &[],
+        )
+        .unwrap();
+    }
+    let m = read_mesh(folder.join("s1.off")).unwrap();
+    let (d, nf) = (m.vertex_count(), m.face_count());
+    let lines = |n: usize, f: &dyn Fn(usize) -> String| -> Vec<u8> {
+        (0..n)
+            .map(|i| format!("{}\n", f(i)))
+            .collect::<String>()
+            .into_bytes()
+    };
+    let mut not_text = lines(d, &|i| (i % 2).to_string());
+    not_text[4] = 0xff; // line 3 of "0\n1\n0\n…"
+    let cases: Vec<(&str, &str, Vec<u8>, Vec<String>)> = vec![
+        (
+            "short per-vertex file",
+            "s1.labels.txt",
+            lines(5, &|_| "1".into()),
+            vec![format!("5 labels, but the mesh s1 has {d} vertices")],
+        ),
+        (
+            "long .seg",
+            "s1.seg",
+            lines(nf + 1, &|_| "2".into()),
+            vec![format!("{} labels, but the mesh s1 has {nf} faces", nf + 1)],
+        ),
+        (
+            "a decimal on line 7",
+            "s1.labels.txt",
+            lines(d, &|i| if i == 6 { "1.5".into() } else { "1".into() }),
+            vec!["s1.labels.txt:7: \"1.5\" is not an integer label".into()],
+        ),
+        (
+            "a word on line 1",
+            "s1.seg",
+            lines(nf, &|i| if i == 0 { "seat".into() } else { "1".into() }),
+            vec!["s1.seg:1: \"seat\" is not an integer label".into()],
+        ),
+        (
+            "an empty .seg",
+            "s1.seg",
+            Vec::new(),
+            vec![format!("0 labels, but the mesh s1 has {nf} faces")],
+        ),
+        (
+            "an empty per-vertex file",
+            "s1.labels.txt",
+            b"\n\n".to_vec(),
+            vec![format!("0 labels, but the mesh s1 has {d} vertices")],
+        ),
+        (
+            "a byte that is not text",
+            "s1.labels.txt",
+            not_text,
+            vec!["s1.labels.txt:3:".into(), "is not an integer label".into()],
+        ),
+        (
+            "a label beyond i32",
+            "s1.seg",
+            lines(nf, &|i| {
+                if i == 9 {
+                    "99999999999".into()
+                } else {
+                    "0".into()
+                }
+            }),
+            vec!["s1.seg:10: \"99999999999\" is not an integer label".into()],
+        ),
+        (
+            "only unlabelled lines",
+            "s1.labels.txt",
+            lines(d, &|_| "-1".into()),
+            vec!["s1.labels.txt: no label ≥ 0".into()],
+        ),
+        (
+            "a file for no mesh",
+            "chair.seg",
+            lines(nf, &|_| "1".into()),
+            vec!["chair.seg: no mesh has the stem \"chair\"".into()],
+        ),
+    ];
+    let cache = dir.join("cache");
+    for (i, (what, name, bytes, expected)) in cases.iter().enumerate() {
+        let labels = dir.join(format!("labels{i}"));
+        std::fs::create_dir_all(&labels).unwrap();
+        let file = labels.join(name);
+        std::fs::write(&file, bytes).unwrap();
+        let out = dir.join(format!("out{i}"));
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "propagate".into(),
+            folder.clone().into(),
+            "--labels".into(),
+            file.clone().into(),
+            "-o".into(),
+            out.clone().into(),
+            "--cache".into(),
+            cache.clone().into(),
+        ];
+        args.extend(PIPE.iter().map(Into::into));
+        let o = coseg(&args);
+        let (_, stderr) = text(&o);
+        assert_eq!(
+            verdict(what, name, &o),
+            Verdict::Refused,
+            "{what}: {stderr}"
+        );
+        assert!(
+            stderr.contains(&file.display().to_string()),
+            "{what}: {stderr}"
+        );
+        for e in expected {
+            assert!(
+                stderr.contains(e.as_str()),
+                "{what}: expected {e:?} in\n{stderr}"
+            );
+        }
+        let written: Vec<_> = std::fs::read_dir(&out)
+            .map(|r| r.map(|e| e.unwrap().file_name()).collect())
+            .unwrap_or_default();
+        assert!(
+            written.iter().all(|n| n == ".cache"),
+            "{what}: wrote {written:?}"
+        );
+    }
+    // A labels folder of which no file matches a mesh: refused, naming the folder.
+    let stray = dir.join("stray");
+    std::fs::create_dir_all(&stray).unwrap();
+    std::fs::write(stray.join("chair.labels.txt"), "1\n").unwrap();
+    let mut args: Vec<std::ffi::OsString> = vec![
+        "propagate".into(),
+        folder.into(),
+        "--labels".into(),
+        stray.clone().into(),
+        "-o".into(),
+        dir.join("out_stray").into(),
+        "--cache".into(),
+        cache.into(),
+    ];
+    args.extend(PIPE.iter().map(Into::into));
+    let o = coseg(&args);
+    let (_, stderr) = text(&o);
+    assert_eq!(verdict("stray folder", "stray", &o), Verdict::Refused);
+    assert!(
+        stderr.contains(&stray.display().to_string()) && stderr.contains("matches a mesh"),
+        "{stderr}"
+    );
 }

@@ -249,3 +249,55 @@ fn bad_bands_entries_are_rebuilt_from_the_full_entry() {
     assert_eq!((r.outcome, r.warnings.len()), (CacheOutcome::Hit, 0));
     assert_eq!(std::fs::read(&path).unwrap(), bytes);
 }
+
+/// Frames `payload` as a cache entry of the full kind under `key` (the layout of
+/// `coseg::cache`: magic, version, key, payload length, BLAKE3 of the payload), so that the
+/// checksum holds and the payload decoder is reached.
+fn framed(key: &coseg::cache::ShapeKey, payload: &[u8]) -> Vec<u8> {
+    let mut bytes = b"COSEGSHP".to_vec();
+    bytes.extend_from_slice(&coseg::cache::FORMAT_VERSION.to_le_bytes());
+    bytes.extend_from_slice(&key.0);
+    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(blake3::hash(payload).as_bytes());
+    bytes.extend_from_slice(payload);
+    bytes
+}
+
+/// Regression (fuzzing, `cache_entry` target): a payload behind a valid checksum whose
+/// descriptor-name string declares a length of 2⁵⁶ − 2 bytes made bincode allocate that much
+/// before reading, and the process abort (`memory allocation … failed`; under ASan,
+/// `allocation-size-too-big`). The input is the fuzzer's, byte for byte
+/// (`tests/data/fuzz/cache_entry_huge_string_length.bin`: byte 0 the target's selector, the
+/// rest the payload). Now the decoder's memory limit refuses it: the entry is untrusted with
+/// the reason and, through the cache, recomputed.
+#[test]
+fn a_cache_entry_declaring_a_huge_string_is_refused_not_an_abort() {
+    let input = std::fs::read(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("tests/data/fuzz/cache_entry_huge_string_length.bin"),
+    )
+    .unwrap();
+    let (pick, payload) = (input[0], &input[1..]);
+    // As the fuzz target runs it: the payload's first 32 bytes are the key.
+    let key = coseg::cache::ShapeKey(payload[..32].try_into().unwrap());
+    let e = coseg::pipeline::decode_shape_entry(&framed(&key, payload), &key, (pick >> 1) as usize)
+        .unwrap_err();
+    assert!(
+        e.contains("does not decode") && e.to_lowercase().contains("limit"),
+        "{e}"
+    );
+    // Through the cache: the same payload stored under a mesh's key is recomputed.
+    let dir = tempfile::tempdir().unwrap();
+    let (m, o) = (mesh(), opts());
+    let key = shape_key(&m, &o);
+    std::fs::write(cache_path(dir.path(), &key), framed(&key, payload)).unwrap();
+    let r = load_or_compute(&m, &o, dir.path()).unwrap();
+    assert!(
+        is_recomputed(&r.outcome, "does not decode"),
+        "{:?}",
+        r.outcome
+    );
+    assert_eq!(r.data, compute_shape_data(&m, &o).unwrap());
+    let again = load_or_compute(&m, &o, dir.path()).unwrap();
+    assert_eq!(again.outcome, CacheOutcome::Hit);
+}

@@ -19,7 +19,11 @@ fuzz_target!(|data: &[u8]| {
     let n = payload.len().min(32);
     key[..n].copy_from_slice(&payload[..n]);
     let key = ShapeKey(key);
-    let magic: &[u8; 8] = if pick & 1 == 0 { b"COSEGSHP" } else { b"COSEGBND" };
+    let magic: &[u8; 8] = if pick & 1 == 0 {
+        b"COSEGSHP"
+    } else {
+        b"COSEGBND"
+    };
     let mut bytes = Vec::with_capacity(84 + payload.len());
     bytes.extend_from_slice(magic);
     bytes.extend_from_slice(&FORMAT_VERSION.to_le_bytes());

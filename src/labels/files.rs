@@ -54,7 +54,7 @@ pub struct ShapeLabels {
 
 /// Reads a label file: one integer per line (blank lines skipped, surrounding spaces ignored);
 /// the kind comes from the extension ([`LabelKind::of_path`]). Errors name the file and the
-/// 1-based line.
+/// 1-based line. The bytes are parsed by [`parse_label_file`].
 ///
 /// ```
 /// let p = std::env::temp_dir().join(format!("coseg-doc-seg-{}.seg", std::process::id()));
@@ -64,33 +64,52 @@ pub struct ShapeLabels {
 /// # std::fs::remove_file(&p).unwrap();
 /// ```
 pub fn read_label_file(path: &Path) -> Result<(LabelKind, Vec<i32>), LabelError> {
-    let text = std::fs::read_to_string(path).map_err(|source| LabelError::Io {
+    let data = std::fs::read(path).map_err(|source| LabelError::Io {
         path: path.display().to_string(),
         source,
     })?;
-    let mut labels = Vec::with_capacity(text.len() / 2);
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim();
+    parse_label_file(&data, path)
+}
+
+/// Parses the bytes of a label file named `path` (used for the kind, by its extension, and in
+/// errors; nothing is read from disk): one integer in `i32` per line, lines split at `\n` with
+/// an optional `\r` before it, blank lines skipped, surrounding spaces ignored. A line that is
+/// not UTF-8 or not an integer in range is a [`LabelError::BadLabel`] naming the file and the
+/// 1-based line (its text shortened to 40 characters). This is the entry point of the
+/// `read_label_file` fuzz target: any bytes give labels or such an error, never a panic.
+///
+/// ```
+/// use coseg::labels::{LabelKind, parse_label_file};
+/// let (kind, l) = parse_label_file(b" 3\r\n\n-1\n", "a.seg".as_ref()).unwrap();
+/// assert_eq!((kind, l), (LabelKind::Face, vec![3, -1]));
+/// let e = parse_label_file(b"1\n2.5\n", "a.labels.txt".as_ref()).unwrap_err();
+/// assert_eq!(e.to_string(), "a.labels.txt:2: \"2.5\" is not an integer label");
+/// ```
+pub fn parse_label_file(data: &[u8], path: &Path) -> Result<(LabelKind, Vec<i32>), LabelError> {
+    let bad = |line: usize, text: &str| LabelError::BadLabel {
+        path: path.display().to_string(),
+        line,
+        text: text.chars().take(40).collect(),
+    };
+    let mut labels = Vec::new();
+    // `split` yields one empty piece after a final `\n`, which the blank-line rule skips.
+    for (i, line) in data.split(|&b| b == b'\n').enumerate() {
+        let line = line.strip_suffix(b"\r").unwrap_or(line);
+        let t = std::str::from_utf8(line)
+            .map_err(|_| bad(i + 1, &String::from_utf8_lossy(line)))?
+            .trim();
         if t.is_empty() {
             continue;
         }
-        let v: i64 = t.parse().map_err(|_| LabelError::BadLabel {
-            path: path.display().to_string(),
-            line: i + 1,
-            text: t.chars().take(40).collect(),
-        })?;
-        let v = i32::try_from(v).map_err(|_| LabelError::BadLabel {
-            path: path.display().to_string(),
-            line: i + 1,
-            text: t.to_string(),
-        })?;
+        let v: i32 = t.parse().map_err(|_| bad(i + 1, t))?;
         labels.push(v);
     }
     Ok((LabelKind::of_path(path), labels))
 }
 
 /// Reads `path` ([`read_label_file`]) for `mesh` (named `mesh_name` in errors), checks the
-/// count against the mesh's vertices or faces, and converts per-face labels to per-vertex.
+/// count against the mesh's vertices or faces, and converts per-face labels to per-vertex
+/// ([`parse_shape_labels`] on the file's bytes).
 ///
 /// ```
 /// use coseg::mesh::TriMesh;
@@ -106,7 +125,34 @@ pub fn read_shape_labels(
     mesh: &TriMesh,
     mesh_name: &str,
 ) -> Result<ShapeLabels, LabelError> {
-    let (kind, file_labels) = read_label_file(path)?;
+    let data = std::fs::read(path).map_err(|source| LabelError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    parse_shape_labels(&data, path, mesh, mesh_name)
+}
+
+/// [`read_shape_labels`] on bytes already read from `path` (named in errors, its extension
+/// gives the kind): [`parse_label_file`], the count check against `mesh` (an empty file has 0
+/// labels and is refused like any wrong count), per-face to per-vertex conversion, negative
+/// labels normalised to `-1`. Any bytes give labels of the mesh's length or an error naming
+/// `path`, never a panic (the `read_label_file` fuzz target).
+///
+/// ```
+/// use coseg::mesh::TriMesh;
+/// let m = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
+/// let l = coseg::labels::parse_shape_labels(b"7\n", "t.seg".as_ref(), &m, "t").unwrap();
+/// assert_eq!(l.vertex_labels, vec![7, 7, 7]);
+/// let e = coseg::labels::parse_shape_labels(b"", "t.seg".as_ref(), &m, "t").unwrap_err();
+/// assert_eq!(e.to_string(), "t.seg: 0 labels, but the mesh t has 1 faces");
+/// ```
+pub fn parse_shape_labels(
+    data: &[u8],
+    path: &Path,
+    mesh: &TriMesh,
+    mesh_name: &str,
+) -> Result<ShapeLabels, LabelError> {
+    let (kind, file_labels) = parse_label_file(data, path)?;
     let (what, expected) = match kind {
         LabelKind::Vertex => ("vertices", mesh.vertex_count()),
         LabelKind::Face => ("faces", mesh.face_count()),

@@ -32,7 +32,8 @@ mod files;
 pub use convert::{faces_to_vertices, label_set, vertices_to_faces};
 pub use files::{
     LabelKind, MatchedLabels, PartNames, ShapeLabels, label_file_stem, match_label_files,
-    read_label_file, read_part_names, read_shape_labels, write_face_labels, write_vertex_labels,
+    parse_label_file, parse_shape_labels, read_label_file, read_part_names, read_shape_labels,
+    write_face_labels, write_vertex_labels,
 };
 
 use thiserror::Error;
@@ -72,6 +73,15 @@ pub enum LabelError {
         expected: usize,
         /// Labels in the file.
         got: usize,
+    },
+    /// Label files that carry no label `≥ 0` (every line negative: unlabelled), when no other
+    /// annotation is left to propagate.
+    #[error(
+        "{paths}: no label ≥ 0 (every line is negative, i.e. unlabelled): nothing to propagate"
+    )]
+    Unlabelled {
+        /// The files, comma-separated.
+        paths: String,
     },
     /// A label vector given in memory does not match the mesh.
     #[error("{got} labels for a mesh of {expected} {what}")]

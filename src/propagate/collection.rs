@@ -2,7 +2,9 @@
 
 use super::{PropagateError, PropagateOptions, Propagation, propagate_labels};
 use crate::graph::{GraphOptions, ShapeGraph, SkippedFile, load_collection};
-use crate::labels::{LabelKind, PartNames, match_label_files, read_part_names, read_shape_labels};
+use crate::labels::{
+    LabelError, LabelKind, PartNames, match_label_files, read_part_names, read_shape_labels,
+};
 use crate::mesh::TriMesh;
 use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
@@ -70,7 +72,9 @@ impl PropagatedCollection {
 /// Loads every mesh of `folder` through the per-shape cache, matches the label files of
 /// `labels` (folders matched by stem, or files; see [`match_label_files`]) to them, builds the
 /// shape graph and heat smoothers and runs [`propagate_labels`]. Unreadable meshes are skipped
-/// (listed in `skipped`); a label file that does not fit its mesh is an error naming it.
+/// (listed in `skipped`); a label file that does not fit its mesh (wrong count, a line that is
+/// not an integer, an empty file) is an error naming it, and so are label inputs of which no
+/// file matches a mesh and annotations that are all unlabelled (`-1`).
 ///
 /// ```no_run
 /// use coseg::propagate::{propagate_collection, PropagateCollectionOptions};
@@ -93,13 +97,27 @@ pub fn propagate_collection(
     let mut warnings = loaded.warnings.clone();
     let stems: Vec<String> = loaded.nodes.iter().map(|n| n.name.clone()).collect();
     let (matched, w) = match_label_files(labels, &stems)?;
+    if matched.is_empty() && !stems.is_empty() {
+        // Say which inputs matched nothing (the warnings would be lost with the error).
+        let inputs: Vec<String> = labels.iter().map(|p| p.display().to_string()).collect();
+        return Err(LabelError::Match {
+            path: inputs.join(", "),
+            message: format!(
+                "no label file (<stem>.seg or <stem>.labels.txt) matches a mesh of {}",
+                folder.display()
+            ),
+        }
+        .into());
+    }
     warnings.extend(w);
     let mut annotations: Vec<Option<Vec<i32>>> = vec![None; stems.len()];
     let mut sources = Vec::new();
+    let mut unlabelled = Vec::new();
     for (i, path) in matched {
         let l = read_shape_labels(&path, &loaded.meshes[i], &stems[i])?;
         if l.vertex_labels.iter().all(|&x| x < 0) {
             warnings.push(format!("{}: no labelled vertex, not used", path.display()));
+            unlabelled.push(path.display().to_string());
             continue;
         }
         sources.push(SourceFile {
@@ -110,6 +128,12 @@ pub fn propagate_collection(
         annotations[i] = Some(l.vertex_labels);
     }
     if sources.is_empty() {
+        if !unlabelled.is_empty() {
+            return Err(LabelError::Unlabelled {
+                paths: unlabelled.join(", "),
+            }
+            .into());
+        }
         return Err(PropagateError::NoLabels);
     }
     let part_names = match &options.part_names {
