@@ -792,36 +792,38 @@ fn propagate<'py>(
         let list = shapes_from(list, names, files)?;
         let inputs = label_inputs(&labels)?;
         let pipe = opts.pipeline.clone();
-        py.detach(|| -> Result<(PropagatedCollection, Vec<&'static str>), BoxError> {
-            // The annotations first: bad labels fail before the per-shape stage runs.
-            let (annotations, sources, mut warnings) = annotations_of(&list, inputs)?;
-            if sources.is_empty() {
-                return Err(PropagateError::NoLabels.into());
-            }
-            let part_names = match (&names_file, names_map) {
-                (Some(p), _) => read_part_names(p)?,
-                (None, Some(m)) => m,
-                (None, None) => PartNames::new(),
-            };
-            let loaded = load_arrays(list, &pipe, cache.as_deref())?;
-            warnings.extend(loaded.warnings);
-            let solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, &opts)?;
-            warnings.extend(solved.warnings);
-            let result = PropagatedCollection {
-                paths: loaded.files.iter().map(PathBuf::from).collect(),
-                meshes: loaded.meshes,
-                graph: solved.graph,
-                smoothers: solved.smoothers,
-                propagation: solved.propagation,
-                sources,
-                part_names,
-                skipped: Vec::new(),
-                // Shapes in memory: `outcomes` below says where their data came from.
-                outcomes: Vec::new(),
-                warnings,
-            };
-            Ok((result, loaded.outcomes))
-        })
+        py.detach(
+            || -> Result<(PropagatedCollection, Vec<&'static str>), BoxError> {
+                // The annotations first: bad labels fail before the per-shape stage runs.
+                let (annotations, sources, mut warnings) = annotations_of(&list, inputs)?;
+                if sources.is_empty() {
+                    return Err(PropagateError::NoLabels.into());
+                }
+                let part_names = match (&names_file, names_map) {
+                    (Some(p), _) => read_part_names(p)?,
+                    (None, Some(m)) => m,
+                    (None, None) => PartNames::new(),
+                };
+                let loaded = load_arrays(list, &pipe, cache.as_deref())?;
+                warnings.extend(loaded.warnings);
+                let solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, &opts)?;
+                warnings.extend(solved.warnings);
+                let result = PropagatedCollection {
+                    paths: loaded.files.iter().map(PathBuf::from).collect(),
+                    meshes: loaded.meshes,
+                    graph: solved.graph,
+                    smoothers: solved.smoothers,
+                    propagation: solved.propagation,
+                    sources,
+                    part_names,
+                    skipped: Vec::new(),
+                    // Shapes in memory: `outcomes` below says where their data came from.
+                    outcomes: Vec::new(),
+                    warnings,
+                };
+                Ok((result, loaded.outcomes))
+            },
+        )
         .map_err(|e| lib_err(&*e))?
     } else {
         let folder: PathBuf = shapes.extract()?;
