@@ -16,6 +16,16 @@ Per-shape options (every function that computes per-shape data takes them):
   kernel signature, wave kernel signature and multiscale mean-curvature features.
 - ``bands`` (default 20): bands K per feature.
 - ``area_bands`` (default False): cut bands by equal area instead of equal vertex count.
+- ``families`` (default ``"spectral"``): the feature families, a list or a comma-separated
+  string as the CLI's ``--features``: ``"spectral"`` (HKS + WKS + curvature; or any of
+  ``"hks"``, ``"wks"``, ``"curv"`` alone), ``"extrinsic"`` (heights along directions and
+  distances, in the frame ``up``), ``"sdf"`` (shape diameter), ``"user:DIR"`` (``DIR`` holds
+  ``<stem>.npy`` or ``.csv`` per shape; arrays are matched by their name). docs/FEATURES.md.
+- ``up`` (default ``"y"``): frame of the extrinsic family, the collection's up axis
+  (``"x"``, ``"-z"``, ...) or ``"pca"``; ``directions`` (default 100): its height directions.
+- ``family_weights`` (default 1 each): a family's total share of the affinity, a dict
+  ``{"extrinsic": 2}`` or a string ``"extrinsic=2,sdf=0.5"``; used by :func:`segment` (as
+  ``coseg segment``; the pair and propagation stages weight every column equally).
 """
 
 from __future__ import annotations
@@ -42,6 +52,7 @@ __all__ = [
     "features",
     "mesh_format",
     "pair",
+    "propagate",
     "read_mesh",
     "segment",
     "shape_entry",
@@ -59,7 +70,24 @@ DEFAULTS: Dict[str, Any] = dict(_coseg.defaults())
 FORMAT_VERSION: int = _coseg.FORMAT_VERSION
 
 _D = DEFAULTS
-FAMILIES = ("hks", "wks", "curv")
+#: The spectral family's parts, selectable alone in ``families``.
+SPECTRAL = ("hks", "wks", "curv")
+#: The feature families (besides ``"user:DIR"``), as the CLI's ``--features``.
+FAMILIES = ("spectral", "extrinsic", "sdf")
+#: The per-shape options: every function that computes per-shape data takes them (and they
+#: are part of the cache key).
+PIPELINE_OPTIONS = (
+    "eigenpairs",
+    "hks",
+    "wks",
+    "curvature",
+    "bands",
+    "area_bands",
+    "families",
+    "up",
+    "directions",
+    "family_weights",
+)
 MESH_SUFFIXES = (".obj", ".off", ".ply")
 
 #: The per-shape task's result: content key (64 hex digits), vertex count, and the bytes of
@@ -88,14 +116,15 @@ def _as_mesh(V: Any, F: Any, what: str = "mesh") -> Tuple[np.ndarray, np.ndarray
     )
 
 
-def _shape(shape: Any, what: str) -> Tuple[np.ndarray, np.ndarray, Optional[str]]:
-    """``(V, F, name)`` of a ``(V, F)`` pair, a trimesh-like object or a mesh file path."""
+def _shape(shape: Any, what: str) -> Tuple[np.ndarray, np.ndarray, Optional[str], Optional[str]]:
+    """``(V, F, name, file)`` of a ``(V, F)`` pair, a trimesh-like object or a mesh file path
+    (``name`` and ``file`` only for a path)."""
     if isinstance(shape, (str, os.PathLike)):
         V, F = read_mesh(shape)
-        return V, F, Path(shape).stem
+        return V, F, Path(shape).stem, os.fspath(shape)
     if hasattr(shape, "vertices") and hasattr(shape, "faces"):
         V, F = _as_mesh(shape.vertices, shape.faces, what)
-        return V, F, None
+        return V, F, None, None
     try:
         V, F = shape
     except (TypeError, ValueError):
@@ -104,16 +133,75 @@ def _shape(shape: Any, what: str) -> Tuple[np.ndarray, np.ndarray, Optional[str]
             f"got {type(shape).__name__}"
         ) from None
     V, F = _as_mesh(V, F, what)
-    return V, F, None
+    return V, F, None, None
 
 
-def _pipeline(families: Sequence[str], **counts: Any) -> Dict[str, Any]:
-    unknown = set(families) - set(FAMILIES)
+def _shapes(shapes: Any, names: Optional[Sequence[str]]) -> Tuple[list, List[str], List[Optional[str]]]:
+    """The arrays, names and source files of a list of shapes."""
+    arrays, found, files = [], [], []
+    for i, s in enumerate(shapes):
+        V, F, name, file = _shape(s, f"shape {i}")
+        arrays.append((V, F))
+        found.append(name or f"shape{i:03d}")
+        files.append(file)
+    if names is None:
+        names = found
+    names = [str(n) for n in names]
+    if len(names) != len(arrays):
+        raise InputError(f"names: {len(names)} names for {len(arrays)} shapes")
+    return arrays, names, files
+
+
+def _family_list(families: Union[str, Sequence[str]]) -> List[str]:
+    if isinstance(families, str):
+        families = families.split(",")
+    out = [str(f).strip() for f in families if str(f).strip()]
+    unknown = [f for f in out if f not in SPECTRAL + FAMILIES and not (f.startswith("user:") and len(f) > 5)]
     if unknown:
-        raise InputError(f"unknown feature families {sorted(unknown)} (expected {FAMILIES})")
-    for fam, key in zip(FAMILIES, ("hks", "wks", "curvature")):
-        if fam not in families:
-            counts[key] = 0
+        raise InputError(
+            f"unknown feature families {unknown} (expected spectral, hks, wks, curv, extrinsic, sdf or user:DIR)"
+        )
+    if not out:
+        raise InputError("families: no feature family selected")
+    return out
+
+
+def _weights(family_weights: Any) -> str:
+    if family_weights is None:
+        return ""
+    if isinstance(family_weights, str):
+        return family_weights
+    try:
+        items = dict(family_weights).items()
+    except (TypeError, ValueError):
+        raise InputError(
+            f"family_weights: expected a dict {{family: weight}} or a string, got {type(family_weights).__name__}"
+        ) from None
+    return ",".join(f"{k}={float(w)!r}" for k, w in items)
+
+
+def _pipeline(
+    families: Union[str, Sequence[str]] = _D["features"],
+    up: str = _D["up"],
+    directions: int = _D["directions"],
+    family_weights: Any = None,
+    **counts: Any,
+) -> Dict[str, Any]:
+    """The native module's per-shape options from the public keywords: ``families`` becomes
+    the CLI's ``--features`` list (``hks``/``wks``/``curv`` alone zero the other spectral
+    counts)."""
+    fams = _family_list(families)
+    parts = [f for f in fams if f in SPECTRAL]
+    spectral = "spectral" in fams or bool(parts)
+    if parts and "spectral" not in fams:
+        for fam, key in zip(SPECTRAL, ("hks", "wks", "curvature")):
+            if fam not in parts:
+                counts[key] = 0
+    rest = [f for f in fams if f not in SPECTRAL and f != "spectral"]
+    counts["features"] = ",".join((["spectral"] if spectral else []) + rest)
+    counts["up"] = str(up)
+    counts["directions"] = directions
+    counts["family_weights"] = _weights(family_weights)
     return counts
 
 
@@ -151,18 +239,24 @@ def features(
     V: Any,
     F: Any,
     *,
-    families: Sequence[str] = FAMILIES,
+    families: Union[str, Sequence[str]] = _D["features"],
     eigenpairs: int = _D["eigenpairs"],
     hks: int = _D["hks"],
     wks: int = _D["wks"],
     curvature: int = _D["curvature"],
+    up: str = _D["up"],
+    directions: int = _D["directions"],
 ) -> Tuple[List[str], np.ndarray]:
     """Per-vertex descriptors: ``(names, matrix)`` with ``matrix`` ``n x N`` float64 and
-    ``names[j]`` naming column ``j`` (``hks_000``, ..., ``wks_...``, ``curv_...``).
-    ``families`` selects among ``"hks"``, ``"wks"``, ``"curv"``; the counts are per family
-    (defaults 100 each, from 200 eigenpairs)."""
+    ``names[j]`` naming column ``j`` (``hks_000``, ..., ``wks_...``, ``curv_...``, then
+    ``ext_...``, ``sdf_...``, ``user_...`` of the other families). ``families``: see the
+    module's docstring (default ``"spectral"``; ``("wks",)`` alone, ``"spectral,extrinsic"``,
+    ...); the spectral counts are per part (defaults 100 each, from 200 eigenpairs); ``up``
+    and ``directions`` set the extrinsic family (as ``coseg features --up --directions``)."""
     V, F = _as_mesh(V, F)
-    opts = _pipeline(families, eigenpairs=eigenpairs, hks=hks, wks=wks, curvature=curvature)
+    opts = _pipeline(
+        families, up, directions, None, eigenpairs=eigenpairs, hks=hks, wks=wks, curvature=curvature
+    )
     return _coseg.features(V, F, opts)
 
 
@@ -170,20 +264,26 @@ def band_table(
     V: Any,
     F: Any,
     *,
-    families: Sequence[str] = FAMILIES,
+    families: Union[str, Sequence[str]] = _D["features"],
     eigenpairs: int = _D["eigenpairs"],
     hks: int = _D["hks"],
     wks: int = _D["wks"],
     curvature: int = _D["curvature"],
     bands: int = _D["bands"],
     area_bands: bool = _D["area_bands"],
+    up: str = _D["up"],
+    directions: int = _D["directions"],
 ) -> np.ndarray:
     """The band table: ``n x N`` uint8, entry ``(v, j)`` the band (``0..bands``) of vertex
-    ``v`` in feature ``j`` (columns as :func:`features`). Default 20 bands of equal vertex
-    count (``area_bands=True``: equal area)."""
+    ``v`` in feature ``j`` (columns as :func:`features`, same ``families``, ``up``,
+    ``directions``). Default 20 bands of equal vertex count (``area_bands=True``: equal
+    area)."""
     V, F = _as_mesh(V, F)
     opts = _pipeline(
         families,
+        up,
+        directions,
+        None,
         eigenpairs=eigenpairs,
         hks=hks,
         wks=wks,
@@ -192,6 +292,42 @@ def band_table(
         area_bands=area_bands,
     )
     return _coseg.band_table(V, F, opts)
+
+
+_PIPELINE_DOC = """Per-shape options (part of the cache key; defaults as the CLI's): ``eigenpairs`` (200),
+    ``hks``, ``wks``, ``curvature`` (100 each), ``bands`` (20), ``area_bands`` (False),
+    ``families`` (``"spectral"``), ``up`` (``"y"``), ``directions`` (100), ``family_weights``
+    (1 each); see the module's docstring."""
+
+
+def _pipe(
+    eigenpairs: int,
+    hks: int,
+    wks: int,
+    curvature: int,
+    bands: int,
+    area_bands: bool,
+    families: Union[str, Sequence[str]],
+    up: str,
+    directions: int,
+    family_weights: Any,
+) -> Dict[str, Any]:
+    return _pipeline(
+        families,
+        up,
+        directions,
+        family_weights,
+        eigenpairs=eigenpairs,
+        hks=hks,
+        wks=wks,
+        curvature=curvature,
+        bands=bands,
+        area_bands=area_bands,
+    )
+
+
+def _path(p: Optional[Union[str, os.PathLike]]) -> Optional[str]:
+    return None if p is None else os.fspath(p)
 
 
 def pair(
@@ -223,6 +359,10 @@ def pair(
     curvature: int = _D["curvature"],
     bands: int = _D["bands"],
     area_bands: bool = _D["area_bands"],
+    families: Union[str, Sequence[str]] = _D["features"],
+    up: str = _D["up"],
+    directions: int = _D["directions"],
+    family_weights: Any = None,
 ) -> Dict[str, Any]:
     """Stable region correspondences between two shapes (``coseg pair``).
 
@@ -244,9 +384,11 @@ def pair(
     ``map_smoothing_time`` of the map-guided last step. ``cache_dir``: per-shape cache
     (read if valid, written otherwise). ``names``: names of the two shapes (default: file
     stems, or ``shape000``/``shape001``).
+
+    {pipeline}
     """
-    va, fa, na = _shape(shape_a, "shape a")
-    vb, fb, nb = _shape(shape_b, "shape b")
+    va, fa, na, xa = _shape(shape_a, "shape a")
+    vb, fb, nb, xb = _shape(shape_b, "shape b")
     if names is None:
         names = (na or "shape000", nb or "shape001")
     opts = dict(
@@ -266,16 +408,11 @@ def pair(
         map_preset=map_preset,
         map_size=map_size,
         map_smoothing_time=map_smoothing_time,
-        eigenpairs=eigenpairs,
-        hks=hks,
-        wks=wks,
-        curvature=curvature,
-        bands=bands,
-        area_bands=area_bands,
-        cache_dir=None if cache_dir is None else os.fspath(cache_dir),
-        out=None if out is None else os.fspath(out),
+        cache_dir=_path(cache_dir),
+        out=_path(out),
+        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights),
     )
-    return _coseg.pair([(va, fa), (vb, fb)], list(names), opts)
+    return _coseg.pair([(va, fa), (vb, fb)], list(names), opts, [xa, xb])
 
 
 def segment(
@@ -297,6 +434,10 @@ def segment(
     curvature: int = _D["curvature"],
     bands: int = _D["bands"],
     area_bands: bool = _D["area_bands"],
+    families: Union[str, Sequence[str]] = _D["features"],
+    up: str = _D["up"],
+    directions: int = _D["directions"],
+    family_weights: Any = None,
 ) -> Dict[str, Any]:
     """Consistent co-segmentation of a collection (``coseg segment``).
 
@@ -304,8 +445,10 @@ def segment(
     ``coseg segment FOLDER`` does, unreadable files skipped and reported), or a list whose
     items are ``(V, F)`` pairs, trimesh-like objects or file paths. Returns a dict:
     ``names``, ``labels`` (one int32 array per shape, region id per vertex; the last region
-    is the leftovers), ``summary`` (the content of summary.json), ``skipped``, ``warnings``
-    and ``written`` (files written to ``out``, if given: the CLI's region files).
+    is the leftovers), ``summary`` (the content of summary.json), ``skipped``, ``warnings``,
+    ``outcomes`` (per shape ``"hit"``, ``"miss"``, ``"recomputed"`` from the cache, or
+    ``"computed"`` without one) and ``written`` (files written to ``out``, if given: the
+    CLI's region files).
 
     Options (defaults as ``coseg segment``): ``regions`` (6) regions per shape, the last the
     leftovers; ``area_fraction`` (None: 1 / regions) of each region; ``seed`` (None: start
@@ -315,6 +458,8 @@ def segment(
     ``cache_dir``: per-shape cache (for a folder, default ``<out>/.cache``, as the CLI, or
     ``<folder>/.cache`` without ``out``; for a list, none unless given). Fill it on a
     cluster with :func:`coseg.dask.precompute`.
+
+    {pipeline}
     """
     opts = dict(
         regions=regions,
@@ -324,45 +469,180 @@ def segment(
         neighbours=neighbours,
         refine_rounds=refine_rounds,
         smoothing_time=smoothing_time,
-        eigenpairs=eigenpairs,
-        hks=hks,
-        wks=wks,
-        curvature=curvature,
-        bands=bands,
-        area_bands=area_bands,
-        cache_dir=None if cache_dir is None else os.fspath(cache_dir),
-        out=None if out is None else os.fspath(out),
+        cache_dir=_path(cache_dir),
+        out=_path(out),
+        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights),
     )
     if isinstance(shapes, (str, os.PathLike)):
         if names is not None:
             raise InputError("names: a folder's shapes are named by file stem")
         return _coseg.segment(os.fspath(shapes), None, opts)
-    arrays = []
-    found = []
-    for i, s in enumerate(shapes):
-        V, F, name = _shape(s, f"shape {i}")
-        arrays.append((V, F))
-        found.append(name or f"shape{i:03d}")
-    if names is None:
-        names = found
-    names = [str(n) for n in names]
-    if len(names) != len(arrays):
-        raise InputError(f"names: {len(names)} names for {len(arrays)} shapes")
-    return _coseg.segment(arrays, names, opts)
+    arrays, names, files = _shapes(shapes, names)
+    return _coseg.segment(arrays, names, opts, files)
+
+
+def _label_array(labels: Any, what: str) -> Union[None, str, np.ndarray]:
+    """One shape's annotation for the native module: None, a label file path, or int64."""
+    if labels is None:
+        return None
+    if isinstance(labels, (str, os.PathLike)):
+        return os.fspath(labels)
+    a = np.asarray(labels)
+    if a.dtype.kind not in "iu":
+        raise InputError(f"{what}: labels must be integers (-1 = unlabelled), got dtype {a.dtype}")
+    if a.ndim != 1:
+        raise InputError(f"{what}: labels must be one per vertex (1-D), got shape {a.shape}")
+    if a.size and (a.min() < -(2**31) or a.max() > 2**31 - 1):
+        bad = a.min() if a.min() < -(2**31) else a.max()
+        raise InputError(f"{what}: label {bad} is outside the 32-bit label range")
+    return np.ascontiguousarray(a, dtype=np.int64)
+
+
+def propagate(
+    shapes: Any,
+    labels: Any,
+    *,
+    names: Optional[Sequence[str]] = None,
+    cache_dir: Optional[Union[str, os.PathLike]] = None,
+    out: Optional[Union[str, os.PathLike]] = None,
+    part_names: Any = None,
+    complete_limit: int = _D["complete_limit"],
+    neighbours: int = _D["neighbours"],
+    smoothing_time: float = _D["propagate_smoothing_time"],
+    max_sweeps: int = _D["max_sweeps"],
+    network_weight: float = _D["network_weight"],
+    size_prior: float = _D["size_prior"],
+    eigenpairs: int = _D["eigenpairs"],
+    hks: int = _D["hks"],
+    wks: int = _D["wks"],
+    curvature: int = _D["curvature"],
+    bands: int = _D["bands"],
+    area_bands: bool = _D["area_bands"],
+    families: Union[str, Sequence[str]] = _D["features"],
+    up: str = _D["up"],
+    directions: int = _D["directions"],
+    family_weights: Any = None,
+) -> Dict[str, Any]:
+    """Part labels from a few annotated shapes to a whole collection (``coseg propagate``).
+
+    ``shapes`` and ``labels``, either:
+
+    - a list of shapes (``(V, F)`` pairs, trimesh-like objects or mesh file paths) and a list
+      with one entry per shape: an integer array of per-vertex labels (any integers, ``-1``
+      = unlabelled; partial annotations allowed), a label file (``.labels.txt`` per vertex,
+      ``.seg`` per face) or ``None`` for an unlabelled shape; or a dict ``{name: labels}``
+      naming the annotated shapes only;
+    - a folder (every mesh file directly in it, read as ``coseg propagate FOLDER``) and a
+      label file or folder, or a list of them (the CLI's ``--labels``: folders are matched
+      to meshes by stem).
+
+    At least one shape must carry a label. Returns a dict: ``names``; ``labels`` (one int32
+    array per shape: the part label of each vertex, the annotation's integers; ``-1`` only
+    on a shape no labelled shape reaches); ``confidence`` (one float64 array per shape,
+    ``(best - second) / best`` of the vertex's part scores, 1 on annotated vertices);
+    ``parts`` (the labels, ascending); ``shape_confidence`` (float64, area-weighted mean per
+    shape); ``sources`` (names of the annotated shapes); ``summary`` (the content of
+    ``coseg propagate``'s summary.json); ``skipped``, ``warnings``, ``outcomes`` (per shape,
+    as :func:`segment`'s) and ``written`` (with ``out``: ``<name>.labels.txt``,
+    ``<name>.seg``, ``<name>.labels.ply``, ``summary.json``, byte for byte the CLI's; no
+    pictures, as ``coseg propagate --no-pictures``).
+
+    Options (defaults as ``coseg propagate``): ``smoothing_time`` (3e-3, unit-area surface; 0
+    = none) of the part scores; ``max_sweeps`` (3) over the unlabelled shapes;
+    ``network_weight`` (1; 0 = sources only) of labelled neighbours that are not sources;
+    ``size_prior`` (0.25, in [0, 1]) how strongly part sizes follow the sources' area
+    shares; ``complete_limit`` (12) and ``neighbours`` (6) of the shape graph.
+    ``part_names``: a JSON ``{label: name}`` file or a dict ``{label: name}`` (for a list of
+    shapes), carried into the summary. ``cache_dir``: per-shape cache (default for a folder
+    ``<out>/.cache`` as the CLI, else the library's, in the system's temporary folder; for a
+    list, none unless given). ``names``: names of a list's shapes (default: file stems, or
+    ``shape000``, ...).
+
+    Bad labels (wrong length, not integers, not 1-D, out of range, a file that does not fit
+    its mesh, no labelled vertex anywhere) raise :class:`InputError` before anything is
+    computed; a missing label file raises :class:`FileError`.
+
+    {pipeline}
+    """
+    opts = dict(
+        complete_limit=complete_limit,
+        neighbours=neighbours,
+        smoothing_time=smoothing_time,
+        max_sweeps=max_sweeps,
+        network_weight=network_weight,
+        size_prior=size_prior,
+        cache_dir=_path(cache_dir),
+        out=_path(out),
+        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights),
+    )
+    if isinstance(part_names, (str, os.PathLike)):
+        opts["part_names"] = os.fspath(part_names)
+    elif part_names is not None:
+        try:
+            opts["part_names_map"] = {int(k): str(v) for k, v in dict(part_names).items()}
+        except (TypeError, ValueError):
+            raise InputError("part_names: expected a JSON file or a dict {integer label: name}") from None
+    if isinstance(shapes, (str, os.PathLike)):
+        if names is not None:
+            raise InputError("names: a folder's shapes are named by file stem")
+        if isinstance(labels, (str, os.PathLike)):
+            labels = [labels]
+        try:
+            files = [os.fspath(p) for p in labels]
+        except TypeError:
+            raise InputError(
+                "labels: for a folder, give label files or folders (as coseg propagate --labels)"
+            ) from None
+        return _coseg.propagate(os.fspath(shapes), files, None, opts)
+    arrays, names, files = _shapes(shapes, names)
+    if isinstance(labels, dict):
+        unknown = sorted(set(map(str, labels)) - set(names))
+        if unknown:
+            raise InputError(f"labels: no shape named {unknown} (shapes: {names})")
+        by_name = {str(k): v for k, v in labels.items()}
+        labels = [by_name.get(n) for n in names]
+    else:
+        labels = list(labels)
+    if len(labels) != len(arrays):
+        raise InputError(
+            f"labels: {len(labels)} entries for {len(arrays)} shapes (give None for an unlabelled shape)"
+        )
+    entries = [_label_array(l, f"labels of shape {i} ({n})") for i, (l, n) in enumerate(zip(labels, names))]
+    return _coseg.propagate(arrays, entries, names, opts, files)
+
+
+for _f in (pair, segment, propagate):
+    if _f.__doc__:  # None under python -OO
+        _f.__doc__ = _f.__doc__.replace("{pipeline}", _PIPELINE_DOC)
 
 
 def _pipeline_opts(options: Dict[str, Any]) -> Dict[str, Any]:
-    allowed = {"eigenpairs", "hks", "wks", "curvature", "bands", "area_bands"}
-    unknown = set(options) - allowed
+    """The per-shape keywords (:data:`PIPELINE_OPTIONS`) for the native module; unknown keys
+    raise ``TypeError``. Idempotent: its own output passes through unchanged."""
+    if "features" in options:  # already converted
+        allowed = set(PIPELINE_OPTIONS) - {"families"} | {"features"}
+        unknown = set(options) - allowed
+        if unknown:
+            raise TypeError(f"unknown per-shape option(s): {', '.join(sorted(unknown))}")
+        return dict(options)
+    unknown = set(options) - set(PIPELINE_OPTIONS)
     if unknown:
         raise TypeError(f"unknown per-shape option(s): {', '.join(sorted(unknown))}")
-    return dict(options)
+    o = dict(options)
+    fam = dict(
+        families=o.pop("families", _D["features"]),
+        up=o.pop("up", _D["up"]),
+        directions=o.pop("directions", _D["directions"]),
+        family_weights=o.pop("family_weights", None),
+    )
+    return _pipeline(**fam, **o)
 
 
 def shape_key(mesh_bytes: bytes, format: str, **options: Any) -> Tuple[str, int]:
     """``(key, vertices)``: the content key (64 hex digits, as the Rust cache names its files)
     of a whole mesh file's bytes in ``format`` (``"obj"``, ``"off"``, ``"ply"``) under the
-    per-shape options, and the mesh's vertex count. Parses the mesh, computes nothing else."""
+    per-shape options (:data:`PIPELINE_OPTIONS`), and the mesh's vertex count. Parses the
+    mesh, computes nothing else."""
     return _coseg.shape_key(bytes(mesh_bytes), format, _pipeline_opts(options))
 
 

@@ -8,6 +8,7 @@ dominates the cost of a large collection; the collection stage needs only its re
     client = Client(LocalCluster(n_workers=2, threads_per_worker=1))
     report = coseg.dask.precompute("shapes/", client, "shapes/.cache")
     result = coseg.segment("shapes/", cache_dir="shapes/.cache")   # warm: reads the entries
+    # or: coseg.propagate("shapes/", "shapes/labels/", cache_dir="shapes/.cache")
 
 Each task is :func:`coseg.shape_entry` (mesh bytes and options in, cache entry bytes out);
 the client verifies every returned entry against the content key it computed itself and
@@ -93,8 +94,11 @@ def precompute(
 
     ``paths``: a folder (its mesh files, as :func:`mesh_files`) or an iterable of mesh
     files. ``options``: the per-shape options (``eigenpairs``, ``hks``, ``wks``,
-    ``curvature``, ``bands``, ``area_bands``; library defaults), which must match those of
-    the later ``segment`` call, since they are part of the key. ``ship="bytes"`` sends each
+    ``curvature``, ``bands``, ``area_bands``, ``families``, ``up``, ``directions``,
+    ``family_weights``; library defaults), which must match those of the later ``segment``
+    or ``propagate`` call, since they are part of the key. (``families`` with ``user:DIR``
+    cannot run as a pure task: the task sees bytes, not the file name its features are
+    matched by.) ``ship="bytes"`` sends each
     file's bytes with its task (no shared file system needed); ``ship="path"`` sends only
     the path, for clusters whose workers see the same files. ``retries``: how often Dask
     reruns a task whose worker died. Entries come back to the client, which verifies and

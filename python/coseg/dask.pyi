@@ -1,5 +1,5 @@
 from os import PathLike
-from typing import Any, Iterable, List, Tuple, Union
+from typing import Any, Iterable, List, Mapping, Sequence, Tuple, Union
 
 _Path = Union[str, PathLike[str]]
 
@@ -25,4 +25,8 @@ def precompute(
     curvature: int = ...,
     bands: int = ...,
     area_bands: bool = ...,
+    families: Union[str, Sequence[str]] = ...,
+    up: str = ...,
+    directions: int = ...,
+    family_weights: Union[None, str, Mapping[str, float]] = ...,
 ) -> PrecomputeReport: ...

@@ -7,6 +7,7 @@ mod options;
 
 use coseg::cache::CacheOutcome;
 use coseg::graph::{SegmentCollectionOptions, ShapeNode, load_collection, segment_collection};
+use coseg::labels::{LabelKind, PartNames, read_part_names, read_shape_labels};
 use coseg::maps::PresetChoice;
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
 use coseg::output::{
@@ -14,6 +15,10 @@ use coseg::output::{
 };
 use coseg::pipeline::{
     ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
+};
+use coseg::propagate::{
+    PropagateCollectionOptions, PropagateError, PropagatedCollection, PropagationSummary,
+    SourceFile, propagate_collection, propagate_loaded, write_propagation,
 };
 use coseg::shape_task;
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
@@ -30,14 +35,26 @@ use std::path::{Path, PathBuf};
 /// anywhere in its source chain, `InputError` (a `ValueError`) otherwise; the message is the
 /// library's.
 fn lib_err(e: &(dyn std::error::Error + 'static)) -> PyErr {
+    lib_err_in(e, None)
+}
+
+/// [`lib_err`] with the message prefixed by `context: `.
+fn lib_err_in(e: &(dyn std::error::Error + 'static), context: Option<&str>) -> PyErr {
     let mut io = false;
     let mut cur: Option<&(dyn std::error::Error + 'static)> = Some(e);
     while let Some(c) = cur {
         io |= c.downcast_ref::<std::io::Error>().is_some();
         cur = c.source();
     }
-    raise(if io { "FileError" } else { "InputError" }, e.to_string())
+    let message = match context {
+        Some(c) => format!("{c}: {e}"),
+        None => e.to_string(),
+    };
+    raise(if io { "FileError" } else { "InputError" }, message)
 }
+
+/// An error of a computation run without the GIL.
+type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
 /// A `coseg.errors.<class>` exception with `message`.
 fn raise(class: &str, message: String) -> PyErr {
@@ -302,14 +319,43 @@ fn entry_is_valid(
     Ok(py.detach(|| shape_task::entry_is_valid(&cache_dir, &key, vertices)))
 }
 
-/// A shape handed to `pair`/`segment`: its mesh and display name.
+/// A shape handed to `pair`/`segment`/`propagate`: its mesh, display name and the file it was
+/// read from (its name when it came as arrays).
 struct Shape {
     name: String,
     file: String,
+    from_file: bool,
     mesh: TriMesh,
 }
 
-fn shapes_from(list: &Bound<'_, PyList>, names: Option<Vec<String>>) -> PyResult<Vec<Shape>> {
+impl Shape {
+    /// The pipeline options for this shape: user features (`user:DIR`) resolved to its file,
+    /// `DIR/<stem>.npy` or `.csv`, by the stem of the file it was read from or, for arrays, by
+    /// its name (as the CLI resolves them per mesh file).
+    fn pipeline(&self, pipe: &ShapePipelineOptions) -> Result<ShapePipelineOptions, String> {
+        if pipe.families.user.is_none() {
+            return Ok(pipe.clone());
+        }
+        // A trailing dot: the whole name is the stem, even with dots in it.
+        let path = if self.from_file {
+            PathBuf::from(&self.file)
+        } else {
+            PathBuf::from(format!("{}.", self.name))
+        };
+        let mut p = pipe.clone();
+        p.families = pipe
+            .families
+            .for_shape(&path)
+            .map_err(|e| format!("{}: {e}", self.name))?;
+        Ok(p)
+    }
+}
+
+fn shapes_from(
+    list: &Bound<'_, PyList>,
+    names: Option<Vec<String>>,
+    files: Option<Vec<Option<String>>>,
+) -> PyResult<Vec<Shape>> {
     let mut out = Vec::with_capacity(list.len());
     for (i, item) in list.iter().enumerate() {
         let (v, f): (PyReadonlyArray2<f64>, PyReadonlyArray2<i64>) = item.extract()?;
@@ -317,9 +363,11 @@ fn shapes_from(list: &Bound<'_, PyList>, names: Option<Vec<String>>) -> PyResult
             .as_ref()
             .and_then(|n| n.get(i).cloned())
             .unwrap_or_else(|| format!("shape{i:03}"));
+        let file = files.as_ref().and_then(|f| f.get(i).cloned().flatten());
         let mesh = mesh_from(&v, &f, &format!("shape {i} ({name})"))?;
         out.push(Shape {
-            file: name.clone(),
+            from_file: file.is_some(),
+            file: file.unwrap_or_else(|| name.clone()),
             name,
             mesh,
         });
@@ -329,12 +377,13 @@ fn shapes_from(list: &Bound<'_, PyList>, names: Option<Vec<String>>) -> PyResult
 
 /// Pair stage: `{"labels_a", "labels_b", "summary", "written"}`.
 #[pyfunction]
-#[pyo3(signature = (shapes, names=None, options=None))]
+#[pyo3(signature = (shapes, names=None, options=None, files=None))]
 fn pair<'py>(
     py: Python<'py>,
     shapes: Bound<'py, PyList>,
     names: Option<Vec<String>>,
     options: Option<Bound<'py, PyDict>>,
+    files: Option<Vec<Option<String>>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut o = Opts::new(options);
     let pipe = o.pipeline()?;
@@ -342,7 +391,7 @@ fn pair<'py>(
     let out_dir: Option<PathBuf> = o.take("out")?;
     let pair_opts = o.pair()?;
     o.finish()?;
-    let mut shapes = shapes_from(&shapes, names)?;
+    let mut shapes = shapes_from(&shapes, names, files)?;
     if shapes.len() != 2 {
         return Err(input_err(format!(
             "pair needs 2 shapes, got {}",
@@ -356,6 +405,7 @@ fn pair<'py>(
         .detach(|| -> Result<_, Box<dyn std::error::Error + Send + Sync>> {
             let mut data = Vec::new();
             for s in &shapes {
+                let pipe = s.pipeline(&pipe)?;
                 let d = match &cache {
                     Some(dir) => load_or_compute(&s.mesh, &pipe, dir).map(|r| r.data),
                     None => compute_shape_data(&s.mesh, &pipe),
@@ -464,6 +514,7 @@ fn load_arrays(
         .par_iter()
         .map(
             |s| -> Result<(ShapeNode, Vec<String>, &'static str), String> {
+                let pipe = &s.pipeline(pipe)?;
                 let (bands, areas, warnings, how) = match cache {
                     Some(dir) => {
                         let r = load_or_compute_bands(&s.mesh, pipe, dir)
@@ -532,21 +583,22 @@ fn load_folder(folder: &Path, pipe: &ShapePipelineOptions, cache: &Path) -> Resu
 
 /// Collection stage: `{"names", "labels", "summary", "skipped", "warnings", "written"}`.
 #[pyfunction]
-#[pyo3(signature = (shapes, names=None, options=None))]
+#[pyo3(signature = (shapes, names=None, options=None, files=None))]
 fn segment<'py>(
     py: Python<'py>,
     shapes: Bound<'py, PyAny>,
     names: Option<Vec<String>>,
     options: Option<Bound<'py, PyDict>>,
+    files: Option<Vec<Option<String>>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut o = Opts::new(options);
     let pipe = o.pipeline()?;
     let cache: Option<PathBuf> = o.take("cache_dir")?;
     let out_dir: Option<PathBuf> = o.take("out")?;
-    let seg_opts: SegmentCollectionOptions = o.segment()?;
+    let mut seg_opts: SegmentCollectionOptions = o.segment()?;
     o.finish()?;
     let loaded = if let Ok(list) = shapes.cast::<PyList>() {
-        let list = shapes_from(list, names)?;
+        let list = shapes_from(list, names, files)?;
         if list.len() < 2 {
             return Err(input_err(format!(
                 "co-segmentation needs at least 2 readable shapes, got {}",
@@ -578,6 +630,8 @@ fn segment<'py>(
         warnings,
         outcomes,
     } = loaded;
+    // As `coseg segment`: the families' weights over the table's columns.
+    seg_opts.feature_weights = pipe.feature_weights(nodes[0].bands.features);
     let result = py
         .detach(|| segment_collection(nodes, &meshes, &seg_opts))
         .or_raise()?;
@@ -617,6 +671,226 @@ fn segment<'py>(
     Ok(d)
 }
 
+/// One shape's annotation as handed to `propagate`: none, per-vertex labels, or a label file.
+enum LabelInput {
+    None,
+    Array(Vec<i64>),
+    File(PathBuf),
+}
+
+fn label_inputs(list: &Bound<'_, PyList>) -> PyResult<Vec<LabelInput>> {
+    let mut out = Vec::with_capacity(list.len());
+    for (i, item) in list.iter().enumerate() {
+        out.push(if item.is_none() {
+            LabelInput::None
+        } else if let Ok(p) = item.extract::<PathBuf>() {
+            LabelInput::File(p)
+        } else {
+            let a: numpy::PyReadonlyArray1<i64> = item.extract().map_err(|e| {
+                input_err(format!(
+                    "labels {i}: expected a 1-D int64 array, a label file or None ({e})"
+                ))
+            })?;
+            LabelInput::Array(a.as_array().to_vec())
+        });
+    }
+    Ok(out)
+}
+
+/// The annotations of `shapes` (per vertex, `-1` = unlabelled) and the sources among them, or
+/// the error naming the shape whose labels do not fit it. An annotation without a labelled
+/// vertex is not used (a warning), as `coseg propagate` treats such a file.
+fn annotations_of(
+    shapes: &[Shape],
+    inputs: Vec<LabelInput>,
+) -> Result<(Vec<Option<Vec<i32>>>, Vec<SourceFile>, Vec<String>), BoxError> {
+    if inputs.len() != shapes.len() {
+        return Err(format!(
+            "{} label entries for {} shapes (give None for an unlabelled shape)",
+            inputs.len(),
+            shapes.len()
+        )
+        .into());
+    }
+    let mut annotations = Vec::with_capacity(shapes.len());
+    let mut sources = Vec::new();
+    let mut warnings = Vec::new();
+    for (i, (s, input)) in shapes.iter().zip(inputs).enumerate() {
+        let (labels, path, kind) = match input {
+            LabelInput::None => {
+                annotations.push(None);
+                continue;
+            }
+            LabelInput::File(path) => {
+                let l = read_shape_labels(&path, &s.mesh, &s.name)?;
+                (l.vertex_labels, path, l.kind)
+            }
+            LabelInput::Array(a) => {
+                let d = s.mesh.vertex_count();
+                if a.len() != d {
+                    return Err(format!(
+                        "labels of shape {i} ({}): {} labels for a mesh of {d} vertices",
+                        s.name,
+                        a.len()
+                    )
+                    .into());
+                }
+                let mut labels = Vec::with_capacity(d);
+                for (v, &x) in a.iter().enumerate() {
+                    let l = i32::try_from(x).map_err(|_| {
+                        format!(
+                            "labels of shape {i} ({}): vertex {v} has label {x}, outside the \
+                             32-bit label range",
+                            s.name
+                        )
+                    })?;
+                    labels.push(l.max(-1));
+                }
+                (labels, PathBuf::from(ARRAY_SOURCE), LabelKind::Vertex)
+            }
+        };
+        if labels.iter().all(|&l| l < 0) {
+            warnings.push(format!("{}: no labelled vertex, not used", s.name));
+            annotations.push(None);
+            continue;
+        }
+        sources.push(SourceFile {
+            shape: i,
+            path,
+            kind,
+        });
+        annotations.push(Some(labels));
+    }
+    Ok((annotations, sources, warnings))
+}
+
+/// The `label_file` of a source given as an array, in the summary.
+const ARRAY_SOURCE: &str = "<array>";
+
+/// Label propagation: `{"names", "labels", "confidence", "parts", "shape_confidence",
+/// "sources", "summary", "skipped", "warnings", "outcomes", "written"}`.
+#[pyfunction]
+#[pyo3(signature = (shapes, labels, names=None, options=None, files=None))]
+fn propagate<'py>(
+    py: Python<'py>,
+    shapes: Bound<'py, PyAny>,
+    labels: Bound<'py, PyList>,
+    names: Option<Vec<String>>,
+    options: Option<Bound<'py, PyDict>>,
+    files: Option<Vec<Option<String>>>,
+) -> PyResult<Bound<'py, PyDict>> {
+    let mut o = Opts::new(options);
+    let mut opts = PropagateCollectionOptions::default();
+    opts.pipeline = o.pipeline()?;
+    let cache: Option<PathBuf> = o.take("cache_dir")?;
+    let out_dir: Option<PathBuf> = o.take("out")?;
+    let names_file: Option<PathBuf> = o.take("part_names")?;
+    let names_map: Option<PartNames> = o.take("part_names_map")?;
+    (opts.graph, opts.propagate) = o.propagate()?;
+    o.finish()?;
+    let (result, outcomes) = if let Ok(list) = shapes.cast::<PyList>() {
+        let list = shapes_from(list, names, files)?;
+        let inputs = label_inputs(&labels)?;
+        let pipe = opts.pipeline.clone();
+        py.detach(
+            || -> Result<(PropagatedCollection, Vec<&'static str>), BoxError> {
+                // The annotations first: bad labels fail before the per-shape stage runs.
+                let (annotations, sources, mut warnings) = annotations_of(&list, inputs)?;
+                if sources.is_empty() {
+                    return Err(PropagateError::NoLabels.into());
+                }
+                let part_names = match (&names_file, names_map) {
+                    (Some(p), _) => read_part_names(p)?,
+                    (None, Some(m)) => m,
+                    (None, None) => PartNames::new(),
+                };
+                let loaded = load_arrays(list, &pipe, cache.as_deref())?;
+                warnings.extend(loaded.warnings);
+                let solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, &opts)?;
+                warnings.extend(solved.warnings);
+                let result = PropagatedCollection {
+                    paths: loaded.files.iter().map(PathBuf::from).collect(),
+                    meshes: loaded.meshes,
+                    graph: solved.graph,
+                    smoothers: solved.smoothers,
+                    propagation: solved.propagation,
+                    sources,
+                    part_names,
+                    skipped: Vec::new(),
+                    // Shapes in memory: `outcomes` below says where their data came from.
+                    outcomes: Vec::new(),
+                    warnings,
+                };
+                Ok((result, loaded.outcomes))
+            },
+        )
+        .map_err(|e| lib_err(&*e))?
+    } else {
+        let folder: PathBuf = shapes.extract()?;
+        let files: Vec<PathBuf> = labels.extract()?;
+        if names_map.is_some() {
+            return Err(input_err(
+                "part names of a folder come from a file (part_names=PATH)",
+            ));
+        }
+        opts.part_names = names_file;
+        opts.cache_dir = cache.or_else(|| out_dir.as_ref().map(|o| o.join(".cache")));
+        let context = format!("propagating labels over {}", folder.display());
+        let result = py
+            .detach(|| propagate_collection(&folder, &files, &opts))
+            .map_err(|e| lib_err_in(&e, Some(&context)))?;
+        let outcomes = result.outcomes.iter().map(outcome).collect();
+        (result, outcomes)
+    };
+    if result.graph.node_count() == 0 {
+        return Err(input_err("no readable mesh"));
+    }
+    let summary = PropagationSummary::of(&result, &opts.graph, &opts.propagate);
+    let written = match &out_dir {
+        Some(dir) => py
+            .detach(|| write_propagation(dir, &result, &summary))
+            .or_raise()?,
+        None => Vec::new(),
+    };
+    let p = &result.propagation;
+    let n = result.graph.node_count();
+    let d = PyDict::new(py);
+    let names: Vec<String> = (0..n).map(|i| result.graph.node(i).name.clone()).collect();
+    d.set_item("names", names)?;
+    let labels: Vec<Bound<PyArray1<i32>>> = p
+        .labels
+        .iter()
+        .map(|l| PyArray1::from_slice(py, l))
+        .collect();
+    d.set_item("labels", labels)?;
+    let confidence: Vec<Bound<PyArray1<f64>>> = p
+        .confidence
+        .iter()
+        .map(|c| PyArray1::from_slice(py, c))
+        .collect();
+    d.set_item("confidence", confidence)?;
+    d.set_item("parts", p.parts.clone())?;
+    d.set_item(
+        "shape_confidence",
+        PyArray1::from_slice(py, &p.shape_confidence),
+    )?;
+    d.set_item("sources", summary.sources.clone())?;
+    d.set_item("summary", json(py, &summary)?)?;
+    let skipped: Vec<SkippedInput> = result
+        .skipped
+        .iter()
+        .map(|s| SkippedInput {
+            path: s.path.display().to_string(),
+            error: s.error.clone(),
+        })
+        .collect();
+    d.set_item("skipped", json(py, &skipped)?)?;
+    d.set_item("warnings", result.warnings.clone())?;
+    d.set_item("outcomes", outcomes)?;
+    d.set_item("written", written)?;
+    Ok(d)
+}
+
 #[pymodule]
 fn _coseg(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(defaults, m)?)?;
@@ -630,6 +904,7 @@ fn _coseg(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(entry_is_valid, m)?)?;
     m.add_function(wrap_pyfunction!(pair, m)?)?;
     m.add_function(wrap_pyfunction!(segment, m)?)?;
+    m.add_function(wrap_pyfunction!(propagate, m)?)?;
     m.add("FORMAT_VERSION", coseg::cache::FORMAT_VERSION)?;
     Ok(())
 }

@@ -3,11 +3,16 @@
 //! unknown keys rejected so that a typo never passes silently.
 
 use coseg::bands::BandWeighting;
+use coseg::features::{
+    ExtrinsicOptions, FamilyWeights, FeatureError, parse_alignment, parse_families,
+    parse_family_weights,
+};
 use coseg::graph::{CosegmentOptions, GraphOptions, SegmentCollectionOptions};
 use coseg::maps::{
     MapGuidedOptions, MapPreset, PointMapOptions, PresetChoice, ZoomOutOptions, map_preset,
 };
 use coseg::pipeline::ShapePipelineOptions;
+use coseg::propagate::PropagateOptions;
 use coseg::spectral::Spectrum;
 use coseg::stable::{
     Algorithm, AreaReference, Init, RefineOptions, SegmentPairOptions, StableRegionsOptions,
@@ -15,6 +20,11 @@ use coseg::stable::{
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
+
+/// The CLI's `--features` default.
+const DEFAULT_FEATURES: &str = "spectral";
+/// The CLI's `--up` default.
+const DEFAULT_UP: &str = "y";
 
 /// The options dict, consumed key by key.
 pub struct Opts<'py>(Option<Bound<'py, PyDict>>);
@@ -54,9 +64,27 @@ impl<'py> Opts<'py> {
         }
     }
 
-    /// `eigenpairs`, `hks`, `wks`, `curvature`, `bands`, `area_bands`.
+    /// `eigenpairs`, `hks`, `wks`, `curvature`, `bands`, `area_bands`, and the feature
+    /// families: `features` (`spectral,extrinsic,sdf,user:DIR`), `up`, `directions`,
+    /// `family_weights` (`NAME=W,...`), as the CLI's `--features`, `--up`, `--directions`,
+    /// `--family-weights` (same parsers, same defaults).
     pub fn pipeline(&mut self) -> PyResult<ShapePipelineOptions> {
         let mut p = ShapePipelineOptions::default();
+        let features: Option<String> = self.take("features")?;
+        let up: Option<String> = self.take("up")?;
+        let directions: Option<usize> = self.take("directions")?;
+        let weights: Option<String> = self.take("family_weights")?;
+        let lib = |e: FeatureError| super::lib_err(&e);
+        let alignment = parse_alignment(up.as_deref().unwrap_or(DEFAULT_UP)).map_err(lib)?;
+        let (spectral, mut families) =
+            parse_families(features.as_deref().unwrap_or(DEFAULT_FEATURES), alignment)
+                .map_err(lib)?;
+        if let (Some(e), Some(n)) = (families.extrinsic.as_mut(), directions) {
+            e.directions = n;
+        }
+        parse_family_weights(weights.as_deref().unwrap_or(""), &mut families.weights)
+            .map_err(lib)?;
+        p.families = families;
         if let Some(k) = self.take("eigenpairs")? {
             p.spectrum.eigenpairs = k;
         }
@@ -75,7 +103,37 @@ impl<'py> Opts<'py> {
         if self.take::<bool>("area_bands")? == Some(true) {
             p.bands.weighting = BandWeighting::Area;
         }
+        if !spectral {
+            p.descriptors.hks_count = 0;
+            p.descriptors.wks_count = 0;
+            p.descriptors.curvature_count = 0;
+        }
         Ok(p)
+    }
+
+    /// The propagation's graph and solver options, as `coseg propagate` sets them.
+    pub fn propagate(&mut self) -> PyResult<(GraphOptions, PropagateOptions)> {
+        let mut graph = GraphOptions::default();
+        if let Some(v) = self.take("complete_limit")? {
+            graph.complete_limit = v;
+        }
+        if let Some(v) = self.take("neighbours")? {
+            graph.neighbours = v;
+        }
+        let mut p = PropagateOptions::default();
+        if let Some(v) = self.take("smoothing_time")? {
+            p.smoothing_time = v;
+        }
+        if let Some(v) = self.take("max_sweeps")? {
+            p.max_sweeps = v;
+        }
+        if let Some(v) = self.take("network_weight")? {
+            p.network_weight = v;
+        }
+        if let Some(v) = self.take("size_prior")? {
+            p.size_prior = v;
+        }
+        Ok((graph, p))
     }
 
     /// The collection stage's options, as `coseg segment` sets them.
@@ -237,6 +295,16 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("curvature", p.descriptors.curvature_count)?;
     d.set_item("bands", p.bands.bands)?;
     d.set_item("area_bands", p.bands.weighting == BandWeighting::Area)?;
+    d.set_item("features", DEFAULT_FEATURES)?;
+    d.set_item("up", DEFAULT_UP)?;
+    d.set_item("directions", ExtrinsicOptions::default().directions)?;
+    let w = FamilyWeights::default();
+    let weights = PyDict::new(py);
+    weights.set_item("spectral", w.spectral)?;
+    weights.set_item("extrinsic", w.extrinsic)?;
+    weights.set_item("sdf", w.sdf)?;
+    weights.set_item("user", w.user)?;
+    d.set_item("family_weights", weights)?;
     let s = SegmentCollectionOptions::default();
     let refine = s
         .refine
@@ -280,6 +348,11 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let pr = RefineOptions::default();
     d.set_item("pair_refine_rounds", pr.max_rounds)?;
     d.set_item("pair_smoothing_time", pr.smoothing_time)?;
+    let po = PropagateOptions::default();
+    d.set_item("propagate_smoothing_time", po.smoothing_time)?;
+    d.set_item("max_sweeps", po.max_sweeps)?;
+    d.set_item("network_weight", po.network_weight)?;
+    d.set_item("size_prior", po.size_prior)?;
     d.set_item("map_preset", "auto")?;
     d.set_item("map_size", ZoomOutOptions::default().final_size)?;
     d.set_item(

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import coseg
-from conftest import SMALL, cli_flags
+from conftest import COLLECTIONS, SMALL, cli_flags
 
 distributed = pytest.importorskip("dask.distributed")
 import coseg.dask  # noqa: E402
@@ -57,6 +57,28 @@ def test_dask_matches_serial_and_cli(client, chairs, tmp_path, coseg_bin):
     assert "(6 cached)" in cli.stdout, cli.stdout
     for n in sorted(p.name for p in (tmp_path / "warm").iterdir() if ".regions." in p.name):
         assert (tmp_path / "warm" / n).read_bytes() == (tmp_path / "cli" / n).read_bytes(), n
+    # Label propagation reads the same entries warm, and equals a cold run.
+    src = COLLECTIONS / "chairs" / "chairs_00.labels.txt"
+    pw = coseg.propagate(chairs, src, cache_dir=dist, **SMALL)
+    assert pw["outcomes"] == ["hit"] * 6 and pw["sources"] == ["chairs_00"]
+    pc = coseg.propagate(chairs, src, cache_dir=tmp_path / "cold-cache", **SMALL)
+    assert all(np.array_equal(a, b) for a, b in zip(pw["labels"], pc["labels"]))
+
+
+def test_dask_with_feature_families(client, chairs, tmp_path):
+    """The feature families are part of the key: precompute with them, and segment with the
+    same families is warm and equals a serial run."""
+    fam = dict(families="spectral,extrinsic", up="z", directions=6, family_weights={"extrinsic": 2})
+    cache = tmp_path / "fam-cache"
+    rep = coseg.dask.precompute(chairs, client, cache, **SMALL, **fam)
+    assert rep.ok and len(rep.computed) == 6
+    plain = coseg.shape_key(sorted(chairs.glob("*.obj"))[0].read_bytes(), "obj", **SMALL)
+    with_fam = coseg.shape_key(sorted(chairs.glob("*.obj"))[0].read_bytes(), "obj", **SMALL, **fam)
+    assert plain[0] != with_fam[0] and (cache / f"{with_fam[0]}.coseg-shape").is_file()
+    warm = coseg.segment(chairs, cache_dir=cache, regions=4, **SMALL, **fam)
+    assert warm["outcomes"] == ["hit"] * 6
+    cold = coseg.segment(chairs, cache_dir=tmp_path / "c2", regions=4, **SMALL, **fam)
+    assert all(np.array_equal(a, b) for a, b in zip(warm["labels"], cold["labels"]))
 
 
 def test_failures_are_skipped_and_a_rerun_resumes(client, chairs, tmp_path):

@@ -1,7 +1,8 @@
 //! [`propagate_collection`]: a folder of meshes and its label files in one call.
 
 use super::{PropagateError, PropagateOptions, Propagation, propagate_labels};
-use crate::graph::{GraphOptions, ShapeGraph, SkippedFile, load_collection};
+use crate::cache::CacheOutcome;
+use crate::graph::{GraphOptions, ShapeGraph, ShapeNode, SkippedFile, load_collection};
 use crate::labels::{
     LabelError, LabelKind, PartNames, match_label_files, read_part_names, read_shape_labels,
 };
@@ -58,6 +59,9 @@ pub struct PropagatedCollection {
     pub part_names: PartNames,
     /// Mesh files that could not be used.
     pub skipped: Vec<SkippedFile>,
+    /// Where each shape's per-shape data came from (graph order): a cache hit, a miss, or a
+    /// recomputed stale entry.
+    pub outcomes: Vec<CacheOutcome>,
     /// Warnings for the user.
     pub warnings: Vec<String>,
 }
@@ -140,11 +144,61 @@ pub fn propagate_collection(
         Some(p) => read_part_names(p)?,
         None => PartNames::new(),
     };
-    let graph = ShapeGraph::build(loaded.nodes, &options.graph)?;
+    let solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, options)?;
+    warnings.extend(solved.warnings);
+    Ok(PropagatedCollection {
+        paths: loaded.paths,
+        meshes: loaded.meshes,
+        graph: solved.graph,
+        smoothers: solved.smoothers,
+        propagation: solved.propagation,
+        sources,
+        part_names,
+        skipped: loaded.skipped,
+        outcomes: loaded.outcomes,
+        warnings,
+    })
+}
+
+/// Result of [`propagate_loaded`]: the collection stage of [`propagate_collection`].
+#[derive(Debug)]
+pub struct PropagatedShapes {
+    /// The shape graph (nodes hold the band tables).
+    pub graph: ShapeGraph,
+    /// One heat smoother per shape (empty when smoothing is off or failed; see `warnings`).
+    pub smoothers: Vec<HeatSmoother>,
+    /// The labels and confidences.
+    pub propagation: Propagation,
+    /// Warnings for the user (smoothing turned off).
+    pub warnings: Vec<String>,
+}
+
+/// The collection stage of [`propagate_collection`] on shapes already through the per-shape
+/// stage (from a folder, or from arrays in memory): builds the shape graph of `nodes` under
+/// `options.graph` and one heat smoother per mesh (`meshes[i]` is `nodes[i]`'s; smoothing is
+/// turned off with a warning when one fails), then runs [`propagate_labels`] with
+/// `annotations` (one per node, per-vertex, `< 0` = unlabelled). `options.pipeline` and
+/// `options.cache_dir` are not used. The same shapes and annotations give the same labels as
+/// [`propagate_collection`] on their files.
+pub fn propagate_loaded(
+    nodes: Vec<ShapeNode>,
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    options: &PropagateCollectionOptions,
+) -> Result<PropagatedShapes, PropagateError> {
+    options.propagate.validate()?;
+    if meshes.len() != nodes.len() {
+        return Err(PropagateError::BadOption(format!(
+            "{} meshes for {} shapes",
+            meshes.len(),
+            nodes.len()
+        )));
+    }
+    let mut warnings = Vec::new();
+    let graph = ShapeGraph::build(nodes, &options.graph)?;
     let time = options.propagate.smoothing_time;
     let smoothers: Vec<HeatSmoother> = if time > 0.0 {
-        match loaded
-            .meshes
+        match meshes
             .par_iter()
             .map(|m| HeatSmoother::new(m, time))
             .collect::<Result<Vec<_>, _>>()
@@ -159,16 +213,11 @@ pub fn propagate_collection(
         Vec::new()
     };
     let smooth = (!smoothers.is_empty()).then_some(smoothers.as_slice());
-    let propagation = propagate_labels(&graph, smooth, &annotations, &options.propagate)?;
-    Ok(PropagatedCollection {
-        paths: loaded.paths,
-        meshes: loaded.meshes,
+    let propagation = propagate_labels(&graph, smooth, annotations, &options.propagate)?;
+    Ok(PropagatedShapes {
         graph,
         smoothers,
         propagation,
-        sources,
-        part_names,
-        skipped: loaded.skipped,
         warnings,
     })
 }

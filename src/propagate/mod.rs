@@ -8,6 +8,8 @@
 //!   state, reusing every transport whose voter did not change.
 //! - [`propagate_collection`]: a folder of meshes and a folder (or list) of label files in
 //!   one call, as `coseg propagate` runs it; [`write_propagation`] writes its files.
+//!   [`propagate_loaded`] is its collection stage alone, for shapes already in memory (the
+//!   Python package's `coseg.propagate` on arrays).
 
 mod collection;
 mod options;
@@ -15,7 +17,8 @@ mod solve;
 mod write;
 
 pub use collection::{
-    PropagateCollectionOptions, PropagatedCollection, SourceFile, propagate_collection,
+    PropagateCollectionOptions, PropagatedCollection, PropagatedShapes, SourceFile,
+    propagate_collection, propagate_loaded,
 };
 pub use options::PropagateOptions;
 pub use solve::{Propagation, UpdateStats, propagate_labels};
