@@ -273,3 +273,52 @@ fn coseg_propagate_on_the_shipped_goblets() {
     assert!(String::from_utf8_lossy(&r.stderr).contains("nomesh.labels.txt"));
     std::fs::remove_dir_all(&out).unwrap();
 }
+
+/// Uneven sampling: on the source, part 0 is 10 large vertices in band 0 plus 30 tiny ones in
+/// band 1 (a densely meshed patch), part 1 is 4 large vertices in band 0 and 6 in band 1.
+/// By vertex count part 0 lies mostly in band 1 (30 / 40) and part 1 mostly in band 0
+/// (4 / 10 beats 10 / 40); by area part 0 lies in band 0 (10 / 10.3) and part 1 in band 1.
+/// The target has one vertex per band: its labels flip with `area_weighted`.
+#[test]
+fn area_weighted_votes_follow_the_parts_area_not_their_vertex_count() {
+    let mut src_labels = Vec::new();
+    let (mut bands, mut areas) = (Vec::new(), Vec::new());
+    let mut push = |count: usize, band: u8, area: f64, part: i32| {
+        for _ in 0..count {
+            bands.push(band);
+            areas.push(area);
+            src_labels.push(part);
+        }
+    };
+    push(10, 0, 1.0, 0);
+    push(30, 1, 0.01, 0);
+    push(4, 0, 1.0, 1);
+    push(6, 1, 1.0, 1);
+    let d = bands.len();
+    let source = BandTable {
+        features: 1,
+        vertices: d,
+        bands: 2,
+        labels: bands,
+    };
+    let target = BandTable {
+        features: 1,
+        vertices: 2,
+        bands: 2,
+        labels: vec![0, 1],
+    };
+    let nodes = vec![
+        ShapeNode::new("src".into(), source, &areas).unwrap(),
+        ShapeNode::new("dst".into(), target, &[1.0, 1.0]).unwrap(),
+    ];
+    let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
+    let ann = vec![Some(src_labels), None];
+    let mut o = PropagateOptions::default();
+    o.size_prior = 0.0;
+    o.area_weighted = false;
+    let p = propagate_labels(&g, None, &ann, &o).unwrap();
+    assert_eq!(p.labels[1], vec![1, 0]);
+    o.area_weighted = true;
+    let p = propagate_labels(&g, None, &ann, &o).unwrap();
+    assert_eq!(p.labels[1], vec![0, 1]);
+}

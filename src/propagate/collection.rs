@@ -116,7 +116,10 @@ pub fn propagate_collection(
         Some(p) => read_part_names(p)?,
         None => PartNames::new(),
     };
-    let graph = ShapeGraph::build(loaded.nodes, &options.graph)?;
+    let features = loaded.nodes.first().map_or(0, |n| n.bands.features);
+    let mut graph = ShapeGraph::build(loaded.nodes, &options.graph)?;
+    // The families' shares of the affinity (`--family-weights`), as `coseg segment` uses them.
+    graph.set_feature_weights(options.pipeline.feature_weights(features))?;
     let time = options.propagate.smoothing_time;
     let smoothers: Vec<HeatSmoother> = if time > 0.0 {
         match loaded

@@ -11,6 +11,7 @@
 
 mod collection;
 mod options;
+mod part_scores;
 mod solve;
 mod write;
 
@@ -18,6 +19,7 @@ pub use collection::{
     PropagateCollectionOptions, PropagatedCollection, SourceFile, propagate_collection,
 };
 pub use options::PropagateOptions;
+pub use part_scores::{GEOMETRIC_FLOOR, PartScore};
 pub use solve::{Propagation, UpdateStats, propagate_labels};
 pub use write::{PropagationSummary, write_propagation};
 

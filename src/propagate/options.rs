@@ -1,6 +1,6 @@
 //! [`PropagateOptions`]: how labels travel from the labelled shapes to the others.
 
-use super::PropagateError;
+use super::{PartScore, PropagateError};
 use serde::{Deserialize, Serialize};
 
 /// Options of [`propagate_labels`](super::propagate_labels).
@@ -26,6 +26,18 @@ pub struct PropagateOptions {
     /// `0`, 69.8 % with `0.25`, 66.1 % with `0.5`; the shipped goblets from one shape 65.0 %,
     /// 75.0 %, 77.0 % (vertex counts).
     pub size_prior: f64,
+    /// How a vertex's histogram values are combined into a part score (see
+    /// [`PartScore`]); default [`PartScore::Affinity`], the band affinity's mean transport.
+    pub part_score: PartScore,
+    /// Weigh the parts' band histograms by vertex area rather than vertex count (meshes with
+    /// uneven sampling: a densely meshed patch then counts for its area, not its vertices).
+    pub area_weighted: bool,
+    /// Rounds of the label-aware refit on every target: after the votes assign it, the
+    /// target's own parts (its current labels) score its vertices as a source would, and
+    /// the scores `votes + refit_weight · own` are assigned again; default 0 (off).
+    pub refit_rounds: usize,
+    /// Weight of the target's own parts in the refit, relative to the votes' 1.
+    pub refit_weight: f64,
 }
 
 impl Default for PropagateOptions {
@@ -35,6 +47,10 @@ impl Default for PropagateOptions {
             max_sweeps: 3,
             network_weight: 1.0,
             size_prior: 0.25,
+            part_score: PartScore::Affinity,
+            area_weighted: false,
+            refit_rounds: 0,
+            refit_weight: 1.0,
         }
     }
 }
@@ -52,6 +68,12 @@ impl PropagateOptions {
             return bad(format!(
                 "network_weight = {} must be finite and non-negative",
                 self.network_weight
+            ));
+        }
+        if !(self.refit_weight.is_finite() && self.refit_weight >= 0.0) {
+            return bad(format!(
+                "refit_weight = {} must be finite and non-negative",
+                self.refit_weight
             ));
         }
         if !(0.0..=1.0).contains(&self.size_prior) {
