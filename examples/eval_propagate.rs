@@ -15,7 +15,7 @@
 //! Common options: `--sources A,B` (chairs: only these single sources), `--cache DIR` (default /tmp/coseg-eval-cache), `--size-prior A`,
 //! `--network-weight W`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
 //! `--part-score affinity|geometric`, `--area-weighted true|false`, `--refit-rounds N`,
-//! `--refit-weight B`;
+//! `--refit-weight B`, `--update-relays true|false`;
 //! the per-shape pipeline as `coseg propagate` takes it: `--features spectral,extrinsic,sdf`,
 //! `--up y|pca|…`, `--directions N`, `--normals N` (extrinsic normal columns), `--family-weights extrinsic=2`, `--bands K`,
 //! `--area-bands`, `--eigenpairs N`. Chairs only: `--gt-swap STEMS:A=B` exchanges labels `A`
@@ -242,6 +242,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--area-weighted" => options.area_weighted = val()?.parse()?,
             "--refit-rounds" => options.refit_rounds = val()?.parse()?,
             "--refit-weight" => options.refit_weight = val()?.parse()?,
+            "--update-relays" => options.update_relays = val()?.parse()?,
             "--neighbours" => graph.neighbours = val()?.parse()?,
             "--complete-limit" => graph.complete_limit = val()?.parse()?,
             "--triples" => triples = val()?.parse()?,

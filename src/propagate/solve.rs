@@ -195,10 +195,16 @@ impl Propagation {
     }
 
     /// Adds, corrects or removes (`labels = None`) the annotation of shape `i` and
-    /// re-propagates from the current state: shapes are re-scored only when a voter's labels
-    /// changed, and votes (transports) of unchanged voters are reused, so nothing per shape
-    /// (spectrum, features, bands, smoothers) is recomputed. Labels must be among
-    /// [`Propagation::parts`].
+    /// re-propagates from the current state; nothing per shape (spectrum, features, bands,
+    /// smoothers) is recomputed. Labels must be among [`Propagation::parts`].
+    ///
+    /// By default (`options.update_relays = false`) this is the quick update: shape `i`'s votes
+    /// on every shape are recomputed and every unlabelled shape is re-assigned once, in graph
+    /// order, with the other votes as cached (the relays of labelled neighbours stay those of
+    /// their previous labels) — the cost of one transport per part and shape plus one
+    /// assignment per shape. With `update_relays = true` the relays of neighbours whose labels
+    /// changed are recomputed too and the sweeps run to the fixed point, as a fresh run does
+    /// (about its cost: a new source changes the labels, so the relays, of every shape).
     ///
     /// ```
     /// use coseg::bands::equal_count_bands;
@@ -449,8 +455,16 @@ impl Propagation {
             self.votes.clear();
             self.vote_rule = rule;
         }
+        // The quick update: one pass, fresh votes from the sources (the changed shape's among
+        // them), the relays of labelled neighbours as cached (from their previous labels).
+        let quick = changed.filter(|_| !options.update_relays);
+        let max_sweeps = if quick.is_some() {
+            0
+        } else {
+            options.max_sweeps
+        };
         let (mut sweeps, mut converged) = (0, false);
-        while sweeps <= options.max_sweeps {
+        while sweeps <= max_sweeps {
             sweeps += 1;
             let mut any = false;
             for &i in &order {
@@ -468,6 +482,12 @@ impl Propagation {
                     .collect();
                 let mut computed = 0;
                 for &(j, _) in &voters {
+                    let cached_relay = quick.is_some_and(|c| c != j)
+                        && !self.sources[j]
+                        && self.votes.contains_key(&(j, i));
+                    if cached_relay {
+                        continue;
+                    }
                     if self.ensure_vote(graph, j, i, options)? {
                         computed += 1;
                     }
