@@ -150,8 +150,8 @@ fn feature_parts(t: &coseg::bands::BandTable, areas: &[f64], k: usize) -> Vec<i3
         let far = (0..d).max_by(|&a, &b| near[a].total_cmp(&near[b])).unwrap();
         centres.push(row(far));
         let c = centres.last().unwrap().clone();
-        for v in 0..d {
-            near[v] = near[v].min(dist(v, &c));
+        for (v, n) in near.iter_mut().enumerate() {
+            *n = n.min(dist(v, &c));
         }
     }
     let mut labels = vec![0i32; d];
@@ -553,8 +553,8 @@ fn bench(
     let t_add = t.elapsed().as_secs_f64();
     let mut fixed = a1;
     let step = 100;
-    for v in (0..fixed.len()).step_by(step) {
-        fixed[v] = p.parts[(v / step) % p.parts.len()];
+    for (v, f) in fixed.iter_mut().enumerate().step_by(step) {
+        *f = p.parts[(v / step) % p.parts.len()];
     }
     let t = Instant::now();
     let fix = p.update(

@@ -78,11 +78,9 @@ pub(crate) fn part_scores(
             hist[base + f * k + b as usize] += m;
         }
     }
-    for r in 0..parts {
-        if mass[r] > 0.0 {
-            hist[r * nf * k..(r + 1) * nf * k]
-                .iter_mut()
-                .for_each(|h| *h /= mass[r]);
+    for (h, &m) in hist.chunks_mut(nf * k).zip(&mass) {
+        if m > 0.0 {
+            h.iter_mut().for_each(|x| *x /= m);
         }
     }
     if rule == PartScore::Geometric {

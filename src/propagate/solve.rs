@@ -384,16 +384,15 @@ fn vote_scores(
     let mut scores = vec![0.0; d_dst * parts];
     let mut ws = w.workspace();
     let scale = 1.0 / (w.unit() * raw);
-    for r in 0..parts {
-        if mass[r] <= 0.0 {
+    for (r, (col, &m)) in scores.chunks_mut(d_dst).zip(&mass).enumerate() {
+        if m <= 0.0 {
             continue;
         }
         let x: Vec<f64> = labels
             .iter()
             .zip(areas)
-            .map(|(&l, &a)| if l == r as i32 { a / mass[r] } else { 0.0 })
+            .map(|(&l, &a)| if l == r as i32 { a / m } else { 0.0 })
             .collect();
-        let col = &mut scores[r * d_dst..(r + 1) * d_dst];
         w.transport(dir, &x, None, col, &mut ws)?;
         col.iter_mut().for_each(|v| *v *= scale);
     }
