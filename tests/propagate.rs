@@ -371,8 +371,8 @@ fn area_weighted_votes_follow_the_parts_area_not_their_vertex_count() {
         labels: vec![0, 1],
     };
     let nodes = vec![
-        ShapeNode::new("src".into(), source, &areas).unwrap(),
-        ShapeNode::new("dst".into(), target, &[1.0, 1.0]).unwrap(),
+        ShapeNode::new("src", source, &areas).unwrap(),
+        ShapeNode::new("dst", target, &[1.0, 1.0]).unwrap(),
     ];
     let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
     let ann = vec![Some(src_labels), None];
