@@ -4,20 +4,35 @@
 //! # COSEG chairs: every chair as the one source, then seeded random triples of sources.
 //! cargo run --release --example eval_propagate -- chairs ../shared/data/coseg_chairs [--triples 10] [--seed 0]
 //! # Near-isometric classes (identity ground truth): a part decomposition of the first shape
-//! # (K farthest-point Voronoi cells, --parts K) carried to the others.
+//! # (K farthest-point Voronoi cells, --parts K, or with --parts-from features K clusters of
+//! # its own band table, its segmentation in feature space) carried to the others.
 //! cargo run --release --example eval_propagate -- identity [--parts 6] MESH...
+//! # Timing (warm cache): propagate from the first mesh, update adding the second.
+//! cargo run --release --example eval_propagate -- bench [--seg DIR] [--reps 3] MESH...
+//! # A shipped collection (per-vertex `<stem>.labels.txt` beside the meshes), as `chairs`.
+//! cargo run --release --example eval_propagate -- labelled collections/goblets
 //! ```
 //! Common options: `--sources A,B` (chairs: only these single sources), `--cache DIR` (default /tmp/coseg-eval-cache), `--size-prior A`,
-//! `--network-weight W`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`.
+//! `--network-weight W`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
+//! `--part-score affinity|geometric`, `--area-weighted true|false`, `--refit-rounds N`,
+//! `--refit-weight B`, `--update-relays true|false`;
+//! the per-shape pipeline as `coseg propagate` takes it: `--features spectral,extrinsic,sdf`,
+//! `--up y|pca|…`, `--directions N`, `--normals N` (extrinsic normal columns), `--family-weights extrinsic=2`, `--bands K`,
+//! `--area-bands`, `--eigenpairs N`. Chairs only: `--gt-swap STEMS:A=B` exchanges labels `A`
+//! and `B` of the ground truth of the listed shapes (annotations and scoring alike), e.g.
+//! `--gt-swap 101,102,103,109,110:1=3` (docs/PROPAGATION.md: those five files label the back
+//! 3 and the legs 1, the other seventeen the reverse).
 //! Accuracy is area-weighted: per face against `.seg` files for the chairs, per vertex for
 //! the identity sets; the source shapes are left out of every mean.
 
+use coseg::bands::BandWeighting;
 use coseg::evaluate::{face_label_agreement, vertex_label_agreement};
+use coseg::features::{parse_alignment, parse_families, parse_family_weights};
 use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
 use coseg::labels::{faces_to_vertices, read_label_file};
 use coseg::mesh::{TriMesh, read_mesh};
 use coseg::pipeline::{ShapePipelineOptions, load_or_compute_bands};
-use coseg::propagate::{PropagateOptions, propagate_labels};
+use coseg::propagate::{PartScore, PropagateOptions, propagate_labels};
 use coseg::spectral::HeatSmoother;
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
@@ -35,6 +50,7 @@ struct Set {
 fn load(
     files: &[PathBuf],
     cache: &std::path::Path,
+    pipeline: &ShapePipelineOptions,
     graph: &GraphOptions,
     time: f64,
 ) -> Result<Set, Box<dyn std::error::Error>> {
@@ -43,7 +59,7 @@ fn load(
         .par_iter()
         .map(|f| {
             let mesh = read_mesh(f).map_err(|e| e.to_string())?;
-            let b = load_or_compute_bands(&mesh, &ShapePipelineOptions::default(), cache)
+            let b = load_or_compute_bands(&mesh, pipeline, cache)
                 .map_err(|e| format!("{}: {e}", f.display()))?;
             let name = f.file_stem().unwrap().to_string_lossy().into_owned();
             let node = ShapeNode::new(name.clone(), b.data.bands, &b.data.vertex_areas)
@@ -57,7 +73,9 @@ fn load(
         meshes.push(m);
         nodes.push(node);
     }
-    let graph = ShapeGraph::build(nodes, graph)?;
+    let features = nodes.first().map_or(0, |n| n.bands.features);
+    let mut graph = ShapeGraph::build(nodes, graph)?;
+    graph.set_feature_weights(pipeline.feature_weights(features))?;
     let smoothers = if time > 0.0 {
         Some(
             meshes
@@ -112,6 +130,57 @@ fn worst(x: &[(usize, f64)]) -> (usize, f64) {
         .unwrap_or((0, f64::NAN))
 }
 
+/// The shape's own segmentation in feature space: `k` clusters of its band-table rows
+/// (k-means, L1 distance between band indices, area-weighted means, farthest-point seeds from
+/// vertex 0, 20 rounds). Intrinsic features cannot tell a left leg from a right one, so these
+/// parts are the kind of regions an intrinsic method can carry (a cluster may span both).
+fn feature_parts(t: &coseg::bands::BandTable, areas: &[f64], k: usize) -> Vec<i32> {
+    let (d, nf) = (t.vertices, t.features);
+    let dist = |v: usize, c: &[f64]| -> f64 {
+        t.row(v)
+            .iter()
+            .zip(c)
+            .map(|(&b, &x)| (b as f64 - x).abs())
+            .sum()
+    };
+    let row = |v: usize| -> Vec<f64> { t.row(v).iter().map(|&b| b as f64).collect() };
+    let mut centres = vec![row(0)];
+    let mut near: Vec<f64> = (0..d).map(|v| dist(v, &centres[0])).collect();
+    while centres.len() < k {
+        let far = (0..d).max_by(|&a, &b| near[a].total_cmp(&near[b])).unwrap();
+        centres.push(row(far));
+        let c = centres.last().unwrap().clone();
+        for (v, n) in near.iter_mut().enumerate() {
+            *n = n.min(dist(v, &c));
+        }
+    }
+    let mut labels = vec![0i32; d];
+    for _ in 0..20 {
+        labels = (0..d)
+            .into_par_iter()
+            .map(|v| {
+                (0..k)
+                    .min_by(|&a, &b| dist(v, &centres[a]).total_cmp(&dist(v, &centres[b])))
+                    .unwrap() as i32
+            })
+            .collect();
+        for (c, centre) in centres.iter_mut().enumerate() {
+            let mut sum = vec![0.0; nf];
+            let mut mass = 0.0;
+            for v in (0..d).filter(|&v| labels[v] == c as i32) {
+                for (s, &b) in sum.iter_mut().zip(t.row(v)) {
+                    *s += areas[v] * b as f64;
+                }
+                mass += areas[v];
+            }
+            if mass > 0.0 {
+                *centre = sum.iter().map(|s| s / mass).collect();
+            }
+        }
+    }
+    labels
+}
+
 /// Farthest-point Voronoi cells (Euclidean) of `k` seeds from vertex 0.
 fn voronoi_parts(mesh: &TriMesh, k: usize) -> Vec<i32> {
     let p = mesh.positions();
@@ -147,6 +216,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let (mut triples, mut seed, mut parts) = (10usize, 0u64, 6usize);
     let mut only: Option<Vec<String>> = None;
     let mut rest = Vec::new();
+    let (mut features, mut up, mut weights) =
+        ("spectral".to_string(), "y".to_string(), String::new());
+    let mut pipeline = ShapePipelineOptions::default();
+    let mut directions = None;
+    let mut normals = 0usize;
+    let mut parts_from = "voronoi".to_string();
+    let mut swaps: Vec<(Vec<String>, i32, i32)> = Vec::new();
+    let (mut seg, mut reps): (Option<PathBuf>, usize) = (None, 3);
     while let Some(a) = args.next() {
         let mut val = || args.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
@@ -155,16 +232,64 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--network-weight" => options.network_weight = val()?.parse()?,
             "--smoothing-time" => options.smoothing_time = val()?.parse()?,
             "--max-sweeps" => options.max_sweeps = val()?.parse()?,
+            "--part-score" => {
+                options.part_score = match val()?.as_str() {
+                    "affinity" => PartScore::Affinity,
+                    "geometric" => PartScore::Geometric,
+                    o => return Err(format!("--part-score {o}: affinity or geometric").into()),
+                }
+            }
+            "--area-weighted" => options.area_weighted = val()?.parse()?,
+            "--refit-rounds" => options.refit_rounds = val()?.parse()?,
+            "--refit-weight" => options.refit_weight = val()?.parse()?,
+            "--update-relays" => options.update_relays = val()?.parse()?,
             "--neighbours" => graph.neighbours = val()?.parse()?,
             "--complete-limit" => graph.complete_limit = val()?.parse()?,
             "--triples" => triples = val()?.parse()?,
             "--seed" => seed = val()?.parse()?,
             "--parts" => parts = val()?.parse()?,
+            "--parts-from" => parts_from = val()?,
+            "--seg" => seg = Some(PathBuf::from(val()?)),
+            "--reps" => reps = val()?.parse()?,
             "--sources" => only = Some(val()?.split(',').map(str::to_string).collect()),
+            "--features" => features = val()?,
+            "--up" => up = val()?,
+            "--family-weights" => weights = val()?,
+            "--directions" => directions = Some(val()?.parse()?),
+            "--normals" => normals = val()?.parse()?,
+            "--bands" => pipeline.bands.bands = val()?.parse()?,
+            "--eigenpairs" => pipeline.spectrum.eigenpairs = val()?.parse()?,
+            "--area-bands" => pipeline.bands.weighting = BandWeighting::Area,
+            "--gt-swap" => {
+                let v = val()?;
+                let (stems, pair) = v.split_once(':').ok_or("--gt-swap STEMS:A=B")?;
+                let (a, b) = pair.split_once('=').ok_or("--gt-swap STEMS:A=B")?;
+                swaps.push((
+                    stems.split(',').map(str::to_string).collect(),
+                    a.parse()?,
+                    b.parse()?,
+                ));
+            }
             _ => rest.push(PathBuf::from(a)),
         }
     }
-    eprintln!("options: {options:?}, graph: {graph:?}");
+    let (spectral, mut families) = parse_families(&features, parse_alignment(&up)?)?;
+    if let Some(e) = families.extrinsic.as_mut() {
+        if let Some(n) = directions {
+            e.directions = n;
+        }
+        e.normal_directions = normals;
+    }
+    parse_family_weights(&weights, &mut families.weights)?;
+    pipeline.families = families;
+    if !spectral {
+        pipeline.descriptors.hks_count = 0;
+        pipeline.descriptors.wks_count = 0;
+        pipeline.descriptors.curvature_count = 0;
+    }
+    eprintln!(
+        "options: {options:?}, graph: {graph:?}, features {features} (up {up}, weights {weights:?})"
+    );
     match mode.as_str() {
         "chairs" => {
             let dir = rest.first().ok_or("chairs DIR")?;
@@ -177,12 +302,27 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .and_then(|s| s.parse::<u64>().ok())
                     .unwrap_or(u64::MAX)
             });
-            let set = load(&files, &cache, &graph, options.smoothing_time)?;
-            let gt: Vec<Vec<i32>> = set
+            let set = load(&files, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let mut gt: Vec<Vec<i32>> = set
                 .names
                 .iter()
                 .map(|n| Ok(read_label_file(&dir.join("gt").join(format!("{n}.seg")))?.1))
                 .collect::<Result<_, Box<dyn std::error::Error>>>()?;
+            for (stems, a, b) in &swaps {
+                for (name, g) in set.names.iter().zip(gt.iter_mut()) {
+                    if stems.contains(name) {
+                        for l in g.iter_mut() {
+                            *l = if *l == *a {
+                                *b
+                            } else if *l == *b {
+                                *a
+                            } else {
+                                *l
+                            };
+                        }
+                    }
+                }
+            }
             let ann = |i: usize| faces_to_vertices(&set.meshes[i], &gt[i]).unwrap();
             let score = |i: usize, l: &[i32]| {
                 face_label_agreement(&set.meshes[i], &gt[i], l)
@@ -191,9 +331,52 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             chairs(&set, &ann, &score, &options, triples, seed, only.as_deref())
         }
+        "labelled" => {
+            // A shipped collection: meshes and `<stem>.labels.txt` (per vertex) in one folder.
+            let dir = rest.first().ok_or("labelled DIR")?;
+            let files = coseg::graph::mesh_files(dir)?;
+            let set = load(&files, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let gt: Vec<Vec<i32>> = set
+                .names
+                .iter()
+                .map(|n| Ok(read_label_file(&dir.join(format!("{n}.labels.txt")))?.1))
+                .collect::<Result<_, Box<dyn std::error::Error>>>()?;
+            let ann = |i: usize| gt[i].clone();
+            let score = |i: usize, l: &[i32]| {
+                vertex_label_agreement(&set.meshes[i], &gt[i], l)
+                    .unwrap()
+                    .accuracy
+            };
+            chairs(&set, &ann, &score, &options, triples, seed, only.as_deref())
+        }
+        "bench" => {
+            // Timing, warm cache: MESH... (the first two are labelled), `--seg DIR` for face
+            // labels by stem (else 6 farthest-point parts of each labelled shape), `--reps N`.
+            let t = Instant::now();
+            let set = load(&rest, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let t_load = t.elapsed().as_secs_f64();
+            let ann = |i: usize| -> Vec<i32> {
+                match &seg {
+                    Some(dir) => {
+                        let f = read_label_file(&dir.join(format!("{}.seg", set.names[i])))
+                            .unwrap()
+                            .1;
+                        faces_to_vertices(&set.meshes[i], &f).unwrap()
+                    }
+                    None => voronoi_parts(&set.meshes[i], parts),
+                }
+            };
+            bench(&set, &ann, &options, reps, t_load)
+        }
         "identity" => {
-            let set = load(&rest, &cache, &graph, options.smoothing_time)?;
-            let truth = voronoi_parts(&set.meshes[0], parts);
+            let set = load(&rest, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let truth = match parts_from.as_str() {
+                "voronoi" => voronoi_parts(&set.meshes[0], parts),
+                "features" => {
+                    feature_parts(&set.graph.node(0).bands, &set.graph.node(0).areas, parts)
+                }
+                o => return Err(format!("--parts-from {o}: voronoi or features").into()),
+            };
             let ann = |_: usize| truth.clone();
             let score = |i: usize, l: &[i32]| {
                 vertex_label_agreement(&set.meshes[i], &truth, l)
@@ -204,7 +387,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             let r = run(&set, &[0], &ann, &score, &options)?;
             let (w, wv) = worst(&r);
             println!(
-                "| source {} ({parts} parts) | {} targets | mean {:.1} % | worst {} {:.1} % | {:.2} s |",
+                "| source {} ({parts} {parts_from} parts) | {} targets | mean {:.1} % | worst {} {:.1} % | {:.2} s |",
                 set.names[0],
                 r.len(),
                 100.0 * mean(&r),
@@ -304,8 +487,8 @@ fn incremental(
     let stats = p.update(
         &set.graph,
         set.smoothers.as_deref(),
-        1,
-        Some(ann(1)),
+        2,
+        Some(ann(2)),
         options,
     )?;
     let t_update = t.elapsed().as_secs_f64();
@@ -327,6 +510,71 @@ fn incremental(
         100.0 * acc(&p.labels),
         t_fresh,
         100.0 * acc(&fresh.labels)
+    );
+    Ok(())
+}
+
+/// `bench` mode: a full propagation from shape 0 (median of `reps`), then
+/// [`coseg::propagate::Propagation::update`] adding shape 1 as a second source, then an update
+/// correcting 1 % of shape 1's vertices; walls in seconds.
+fn bench(
+    set: &Set,
+    ann: &dyn Fn(usize) -> Vec<i32>,
+    options: &PropagateOptions,
+    reps: usize,
+    t_load: f64,
+) -> Result<(), Box<dyn std::error::Error>> {
+    let n = set.names.len();
+    if n < 2 {
+        return Err("bench needs two shapes or more".into());
+    }
+    let vertices: usize = set.meshes.iter().map(|m| m.vertex_count()).sum();
+    let first: Vec<Option<Vec<i32>>> = (0..n).map(|i| (i == 0).then(|| ann(0))).collect();
+    let mut walls = Vec::new();
+    let mut p = None;
+    for _ in 0..reps.max(1) {
+        let t = Instant::now();
+        let r = propagate_labels(&set.graph, set.smoothers.as_deref(), &first, options)?;
+        walls.push(t.elapsed().as_secs_f64());
+        p = Some(r);
+    }
+    let mut p = p.unwrap();
+    walls.sort_by(f64::total_cmp);
+    let sweeps = p.sweeps;
+    let a1 = ann(1);
+    let t = Instant::now();
+    let add = p.update(
+        &set.graph,
+        set.smoothers.as_deref(),
+        1,
+        Some(a1.clone()),
+        options,
+    )?;
+    let t_add = t.elapsed().as_secs_f64();
+    let mut fixed = a1;
+    let step = 100;
+    for (v, f) in fixed.iter_mut().enumerate().step_by(step) {
+        *f = p.parts[(v / step) % p.parts.len()];
+    }
+    let t = Instant::now();
+    let fix = p.update(
+        &set.graph,
+        set.smoothers.as_deref(),
+        1,
+        Some(fixed),
+        options,
+    )?;
+    let t_fix = t.elapsed().as_secs_f64();
+    println!(
+        "| {n} shapes, {vertices} vertices | load (warm cache) {t_load:.2} s | propagate from 1 source: median {:.2} s (min {:.2}, max {:.2}, {} reps, {sweeps} sweeps) | update adding a source {t_add:.3} s ({} shape updates, {} transports) | update correcting 1 % of it {t_fix:.3} s ({} shape updates, {} transports) |",
+        walls[walls.len() / 2],
+        walls[0],
+        walls[walls.len() - 1],
+        walls.len(),
+        add.shape_updates,
+        add.transports,
+        fix.shape_updates,
+        fix.transports
     );
     Ok(())
 }

@@ -462,3 +462,39 @@ fn family_weights_give_each_family_its_total_share() {
     assert!((spectral - 1.0).abs() < 1e-12 && (sdf - 3.0).abs() < 1e-12);
     assert_eq!(small_pipeline().feature_weights(12), None);
 }
+
+#[test]
+fn normal_columns_are_absolute_cosines_whatever_the_winding() {
+    // A horizontal square (normal ±y, the up axis) and a vertical one (normal ±z) far apart.
+    let pos = vec![
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [1.0, 0.0, 1.0],
+        [0.0, 0.0, 1.0],
+        [5.0, 0.0, 0.0],
+        [6.0, 0.0, 0.0],
+        [6.0, 1.0, 0.0],
+        [5.0, 1.0, 0.0],
+    ];
+    let faces = vec![[0, 2, 1], [0, 3, 2], [4, 5, 6], [4, 6, 7]];
+    let flipped: Vec<[u32; 3]> = faces.iter().map(|f| [f[0], f[2], f[1]]).collect();
+    let mut o = ext(0, up("+y"));
+    o.centroid_distance = false;
+    o.axis_distance = false;
+    o.normal_directions = 12;
+    let a = extrinsic_features(&TriMesh::new(pos.clone(), faces).unwrap(), &o).unwrap();
+    let b = extrinsic_features(&TriMesh::new(pos, flipped).unwrap(), &o).unwrap();
+    assert_eq!(a.names.len(), 12);
+    assert_eq!(a.names[0], "ext_nrm_000");
+    assert_eq!(a.values, b.values);
+    // Frame for up = +y: (z, x, y). Horizontal patch: n = up, so |n·u| = u_up; vertical
+    // patch: n = ±z = frame x, so |n·u| = |u_x|.
+    let dirs = height_directions(12, true);
+    for (k, u) in dirs.iter().enumerate() {
+        let col = &a.values[k * 8..(k + 1) * 8];
+        for (v, &x) in col.iter().enumerate() {
+            let expect = if v < 4 { u[2].abs() } else { u[0].abs() };
+            assert!((x - expect).abs() < 1e-12, "dir {k} vertex {v}");
+        }
+    }
+}

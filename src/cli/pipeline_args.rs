@@ -36,8 +36,12 @@ pub struct PipelineArgs {
     /// Number of height directions of the extrinsic family.
     #[arg(long, default_value_t = ExtrinsicOptions::default().directions)]
     directions: usize,
+    /// Number of normal columns of the extrinsic family (|normal · direction|; 0 = none).
+    #[arg(long, default_value_t = 0)]
+    normals: usize,
     /// Family weights in the affinity, e.g. spectral=1,extrinsic=2 (a family's total share;
-    /// default 1 each). Used by `coseg segment`; `coseg pair` weights every column equally.
+    /// default 1 each). Used by `coseg segment` and `coseg propagate`; `coseg pair` weights every
+    /// column equally.
     #[arg(long, default_value = "")]
     family_weights: String,
 }
@@ -49,6 +53,7 @@ impl PipelineArgs {
         let (spectral, mut families) = parse_families(&self.features, parse_alignment(&self.up)?)?;
         if let Some(e) = families.extrinsic.as_mut() {
             e.directions = self.directions;
+            e.normal_directions = self.normals;
         }
         parse_family_weights(&self.family_weights, &mut families.weights)?;
         opts.families = families;

@@ -7,8 +7,8 @@ use coseg::graph::GraphOptions;
 use coseg::labels::PartNames;
 use coseg::output::write_visuals;
 use coseg::propagate::{
-    PropagateCollectionOptions, PropagateOptions, PropagationSummary, propagate_collection,
-    write_propagation,
+    PartScore, PropagateCollectionOptions, PropagateOptions, PropagationSummary,
+    propagate_collection, write_propagation,
 };
 use coseg::render::{RenderOptions, RenderShape};
 use std::path::PathBuf;
@@ -56,6 +56,19 @@ pub struct PropagateArgs {
     /// How strongly part sizes follow the sources' area shares (0 … 1).
     #[arg(long, default_value_t = PropagateOptions::default().size_prior)]
     size_prior: f64,
+    /// Part score: affinity (mean of the per-feature histogram values, the band affinity's
+    /// transport) or geometric (their geometric mean). See docs/PROPAGATION.md.
+    #[arg(long, default_value = "affinity")]
+    part_score: String,
+    /// Weigh the parts' band histograms by vertex area (true) or vertex count (false).
+    #[arg(long, default_value_t = PropagateOptions::default().area_weighted, action = clap::ArgAction::Set)]
+    area_weighted: bool,
+    /// Rounds of the label-aware refit of every target on its own parts (0 = off).
+    #[arg(long, default_value_t = PropagateOptions::default().refit_rounds)]
+    refit_rounds: usize,
+    /// Weight of the target's own parts in the refit, relative to the votes.
+    #[arg(long, default_value_t = PropagateOptions::default().refit_weight)]
+    refit_weight: f64,
     #[command(flatten)]
     pipeline: super::pipeline_args::PipelineArgs,
 }
@@ -70,6 +83,14 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
     options.propagate.max_sweeps = args.max_sweeps;
     options.propagate.network_weight = args.network_weight;
     options.propagate.size_prior = args.size_prior;
+    options.propagate.part_score = match args.part_score.as_str() {
+        "affinity" => PartScore::Affinity,
+        "geometric" => PartScore::Geometric,
+        o => bail!("--part-score {o}: expected affinity or geometric"),
+    };
+    options.propagate.area_weighted = args.area_weighted;
+    options.propagate.refit_rounds = args.refit_rounds;
+    options.propagate.refit_weight = args.refit_weight;
     options.cache_dir = Some(
         args.cache
             .clone()

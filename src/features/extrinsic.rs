@@ -76,6 +76,13 @@ pub struct ExtrinsicOptions {
     pub centroid_distance: bool,
     /// Add the distance to the up axis through the centroid (`ext_axis`, default `true`).
     pub axis_distance: bool,
+    /// Number of normal columns `ext_nrm_000…`: `|n · u|` for the vertex normal `n` (the
+    /// area-weighted mean of its faces' normals) and `u` along [`height_directions`] on the
+    /// upper half-sphere (default 0 = none). The absolute value makes them independent of
+    /// the faces' winding, so components wound inwards give the same values; they tell a
+    /// horizontal patch (a seat) from a vertical one (a chair back) at the same height.
+    #[serde(default)]
+    pub normal_directions: usize,
 }
 
 impl Default for ExtrinsicOptions {
@@ -86,6 +93,7 @@ impl Default for ExtrinsicOptions {
             alignment: Alignment::default(),
             centroid_distance: true,
             axis_distance: true,
+            normal_directions: 0,
         }
     }
 }
@@ -239,7 +247,11 @@ pub fn extrinsic_features(
     mesh: &TriMesh,
     options: &ExtrinsicOptions,
 ) -> Result<FeatureColumns, FeatureError> {
-    if options.directions == 0 && !options.centroid_distance && !options.axis_distance {
+    if options.directions == 0
+        && !options.centroid_distance
+        && !options.axis_distance
+        && options.normal_directions == 0
+    {
         return Err(FeatureError::BadOption(
             "the extrinsic family has no column (0 directions and both distances off)".into(),
         ));
@@ -285,6 +297,30 @@ pub fn extrinsic_features(
     if options.axis_distance {
         names.push("ext_axis".into());
         values.extend(local.iter().map(|p| (p[0] * p[0] + p[1] * p[1]).sqrt()));
+    }
+    if options.normal_directions > 0 {
+        let normals: Vec<[f64; 3]> = mesh
+            .vertex_normals()
+            .iter()
+            .map(|n| {
+                let mut r = [0.0; 3];
+                for (k, axis) in frame.axes.iter().enumerate() {
+                    r[k] = axis[0] * n[0] + axis[1] * n[1] + axis[2] * n[2];
+                }
+                r
+            })
+            .collect();
+        for (i, u) in height_directions(options.normal_directions, true)
+            .iter()
+            .enumerate()
+        {
+            names.push(format!("ext_nrm_{i:03}"));
+            values.extend(
+                normals
+                    .iter()
+                    .map(|n| (u[0] * n[0] + u[1] * n[1] + u[2] * n[2]).abs()),
+            );
+        }
     }
     FeatureColumns::new(d, names, values)
 }

@@ -58,7 +58,10 @@ impl ShapePipelineOptions {
         let spectral = d.hks_count + d.wks_count + d.curvature_count;
         let f = &self.families;
         let ext = f.extrinsic.as_ref().map_or(0, |e| {
-            e.directions + usize::from(e.centroid_distance) + usize::from(e.axis_distance)
+            e.directions
+                + usize::from(e.centroid_distance)
+                + usize::from(e.axis_distance)
+                + e.normal_directions
         });
         let sdf = f.sdf.as_ref().map_or(0, |s| s.smoothing_rounds.len());
         let user = features.saturating_sub(spectral + ext + sdf);

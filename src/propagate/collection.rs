@@ -177,8 +177,8 @@ pub struct PropagatedShapes {
 /// stage (from a folder, or from arrays in memory): builds the shape graph of `nodes` under
 /// `options.graph` and one heat smoother per mesh (`meshes[i]` is `nodes[i]`'s; smoothing is
 /// turned off with a warning when one fails), then runs [`propagate_labels`] with
-/// `annotations` (one per node, per-vertex, `< 0` = unlabelled). `options.pipeline` and
-/// `options.cache_dir` are not used. The same shapes and annotations give the same labels as
+/// `annotations` (one per node, per-vertex, `< 0` = unlabelled). `options.pipeline` gives only the
+/// families' weights; `options.cache_dir` is not used. The same shapes and annotations give the same labels as
 /// [`propagate_collection`] on their files.
 pub fn propagate_loaded(
     nodes: Vec<ShapeNode>,
@@ -195,7 +195,10 @@ pub fn propagate_loaded(
         )));
     }
     let mut warnings = Vec::new();
-    let graph = ShapeGraph::build(nodes, &options.graph)?;
+    let features = nodes.first().map_or(0, |n| n.bands.features);
+    let mut graph = ShapeGraph::build(nodes, &options.graph)?;
+    // The families' shares of the affinity (`--family-weights`), as `coseg segment` uses them.
+    graph.set_feature_weights(options.pipeline.feature_weights(features))?;
     let time = options.propagate.smoothing_time;
     let smoothers: Vec<HeatSmoother> = if time > 0.0 {
         match meshes

@@ -13,6 +13,7 @@
 
 mod collection;
 mod options;
+mod part_scores;
 mod solve;
 mod write;
 
@@ -21,6 +22,7 @@ pub use collection::{
     propagate_collection, propagate_loaded,
 };
 pub use options::PropagateOptions;
+pub use part_scores::{GEOMETRIC_FLOOR, PartScore};
 pub use solve::{Propagation, UpdateStats, propagate_labels};
 pub use write::{PropagationSummary, write_propagation};
 

@@ -1,6 +1,6 @@
 //! [`PropagateOptions`]: how labels travel from the labelled shapes to the others.
 
-use super::PropagateError;
+use super::{PartScore, PropagateError};
 use serde::{Deserialize, Serialize};
 
 /// Options of [`propagate_labels`](super::propagate_labels).
@@ -26,6 +26,29 @@ pub struct PropagateOptions {
     /// `0`, 69.8 % with `0.25`, 66.1 % with `0.5`; the shipped goblets from one shape 65.0 %,
     /// 75.0 %, 77.0 % (vertex counts).
     pub size_prior: f64,
+    /// How a vertex's histogram values are combined into a part score (see
+    /// [`PartScore`]); default [`PartScore::Affinity`], the band affinity's mean transport
+    /// ([`PartScore::Geometric`] measured 1.2 points lower on the COSEG chairs, extrinsic).
+    pub part_score: PartScore,
+    /// Weigh the parts by vertex area rather than vertex count: each part's vote is the
+    /// transport of its area density (`areas / part area`) instead of its indicator over its
+    /// vertex count, so a densely meshed patch counts for its area. Default `false`: measured
+    /// on the COSEG chairs it helps with the extrinsic family (+3.8 points from one source;
+    /// spectral + extrinsic +1.5) but costs the spectral default 2.5 points (68.8 → 66.2 %),
+    /// and on the shipped goblets 0.8 (docs/PROPAGATION.md); use it with `extrinsic`.
+    pub area_weighted: bool,
+    /// Rounds of the label-aware refit on every target: after the votes assign it, the
+    /// target's own parts (its current labels) score its vertices as a source would, and
+    /// the scores `votes + refit_weight · own` are assigned again; default 0 (off: 3 rounds
+    /// measured 2.6 points lower on the COSEG chairs from one source, extrinsic — the refit
+    /// entrenches what the votes got wrong).
+    pub refit_rounds: usize,
+    /// Weight of the target's own parts in the refit, relative to the votes' 1.
+    pub refit_weight: f64,
+    /// Whether [`Propagation::update`](super::Propagation::update) also recomputes the relay
+    /// votes of neighbours whose labels changed and sweeps to the fixed point (about a fresh
+    /// run's cost); default `false`: the quick update (one pass, relays as cached).
+    pub update_relays: bool,
 }
 
 impl Default for PropagateOptions {
@@ -35,6 +58,11 @@ impl Default for PropagateOptions {
             max_sweeps: 3,
             network_weight: 1.0,
             size_prior: 0.25,
+            part_score: PartScore::Affinity,
+            area_weighted: false,
+            refit_rounds: 0,
+            refit_weight: 1.0,
+            update_relays: false,
         }
     }
 }
@@ -52,6 +80,12 @@ impl PropagateOptions {
             return bad(format!(
                 "network_weight = {} must be finite and non-negative",
                 self.network_weight
+            ));
+        }
+        if !(self.refit_weight.is_finite() && self.refit_weight >= 0.0) {
+            return bad(format!(
+                "refit_weight = {} must be finite and non-negative",
+                self.refit_weight
             ));
         }
         if !(0.0..=1.0).contains(&self.size_prior) {

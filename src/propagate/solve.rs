@@ -1,7 +1,8 @@
 //! [`propagate_labels`] and [`Propagation::update`]: part labels from a few labelled shapes to
 //! every shape of a graph.
 
-use super::{PropagateError, PropagateOptions};
+use super::part_scores::part_scores;
+use super::{PartScore, PropagateError, PropagateOptions};
 use crate::affinity::{BandAffinity, Direction, FeaturePairing};
 use crate::graph::ShapeGraph;
 use crate::spectral::HeatSmoother;
@@ -41,6 +42,8 @@ pub struct Propagation {
     votes: BTreeMap<(usize, usize), Vec<f64>>,
     /// Labels of `j` each cached vote was computed from.
     vote_labels: BTreeMap<(usize, usize), Vec<i32>>,
+    /// The score rule and weighting the cached votes were computed with.
+    vote_rule: (PartScore, bool),
 }
 
 /// Statistics of one [`Propagation::update`].
@@ -132,6 +135,7 @@ pub fn propagate_labels(
         annotations: vec![None; n],
         votes: BTreeMap::new(),
         vote_labels: BTreeMap::new(),
+        vote_rule: (options.part_score, options.area_weighted),
     };
     for (i, a) in annotations.iter().enumerate() {
         if let Some(a) = a {
@@ -191,10 +195,16 @@ impl Propagation {
     }
 
     /// Adds, corrects or removes (`labels = None`) the annotation of shape `i` and
-    /// re-propagates from the current state: shapes are re-scored only when a voter's labels
-    /// changed, and votes (transports) of unchanged voters are reused, so nothing per shape
-    /// (spectrum, features, bands, smoothers) is recomputed. Labels must be among
-    /// [`Propagation::parts`].
+    /// re-propagates from the current state; nothing per shape (spectrum, features, bands,
+    /// smoothers) is recomputed. Labels must be among [`Propagation::parts`].
+    ///
+    /// By default (`options.update_relays = false`) this is the quick update: shape `i`'s votes
+    /// on every shape are recomputed and every unlabelled shape is re-assigned once, in graph
+    /// order, with the other votes as cached (the relays of labelled neighbours stay those of
+    /// their previous labels) — the cost of one transport per part and shape plus one
+    /// assignment per shape. With `update_relays = true` the relays of neighbours whose labels
+    /// changed are recomputed too and the sweeps run to the fixed point, as a fresh run does
+    /// (about its cost: a new source changes the labels, so the relays, of every shape).
     ///
     /// ```
     /// use coseg::bands::equal_count_bands;
@@ -286,6 +296,7 @@ impl Propagation {
         graph: &ShapeGraph,
         j: usize,
         i: usize,
+        options: &PropagateOptions,
     ) -> Result<bool, PropagateError> {
         let src = self.vote_source(j);
         if self
@@ -297,31 +308,95 @@ impl Propagation {
         }
         let src = src.to_vec();
         let regions = self.parts.len();
-        let scores = match graph.affinity(j, i) {
-            Some(r) => {
-                let (w, dir) = r?;
-                region_scores(&w, dir, &src, regions, &mut w.workspace())?
-            }
+        let own;
+        let (w, dir) = match graph.affinity(j, i) {
+            Some(r) => r?,
             None => {
                 let (lo, hi) = (j.min(i), j.max(i));
                 let (a, b) = (&graph.node(lo).bands, &graph.node(hi).bands);
-                let pairing = match graph.edges().first() {
-                    Some((_, _, e)) => e.pairing(),
-                    None => FeaturePairing::identity(a.features),
-                };
-                let w = BandAffinity::with_pairing(a, b, &pairing)?;
+                own = graph_pairing(graph, a.features);
+                let w = BandAffinity::with_pairing(a, b, &own)?;
                 let dir = if j < i {
                     Direction::AtoB
                 } else {
                     Direction::BtoA
                 };
-                region_scores(&w, dir, &src, regions, &mut w.workspace())?
+                (w, dir)
             }
         };
+        let scores = vote_scores(&w, dir, &src, &graph.node(j).areas, regions, options)?;
         self.votes.insert((j, i), scores);
         self.vote_labels.insert((j, i), src);
         Ok(true)
     }
+}
+
+/// The feature pairing of the graph's edges (they all share one), or the identity.
+fn graph_pairing(graph: &ShapeGraph, features: usize) -> FeaturePairing {
+    match graph.edges().first() {
+        Some((_, _, e)) => e.pairing(),
+        None => FeaturePairing::identity(features),
+    }
+}
+
+/// Scores of the destination of `dir` for every part of `labels` on its source (`areas`:
+/// the source's vertex areas), in `[0, 1]`-scaled units whatever the rule: for
+/// [`PartScore::Affinity`] the band affinity's transport of each part's indicator over its
+/// size ([`region_scores`], vertex counts) or of its area density (`area_weighted`), divided
+/// by the sum of the raw pair weights; for [`PartScore::Geometric`] the part histograms of
+/// [`part_scores`].
+fn vote_scores(
+    w: &BandAffinity<'_>,
+    dir: Direction,
+    labels: &[i32],
+    areas: &[f64],
+    parts: usize,
+    options: &PropagateOptions,
+) -> Result<Vec<f64>, PropagateError> {
+    if options.part_score == PartScore::Geometric {
+        let areas = options.area_weighted.then_some(areas);
+        return Ok(part_scores(
+            w,
+            dir,
+            labels,
+            areas,
+            parts,
+            options.part_score,
+        ));
+    }
+    let raw: f64 = (0..w.pairs().len()).map(|k| w.raw_weight(k)).sum();
+    if !options.area_weighted {
+        let mut s = region_scores(w, dir, labels, parts, &mut w.workspace())?;
+        s.iter_mut().for_each(|x| *x /= raw);
+        return Ok(s);
+    }
+    // Area-weighted: the transport of each part's area density (areas over the part's area).
+    let d_dst = match dir {
+        Direction::AtoB => w.rows(),
+        Direction::BtoA => w.cols(),
+    };
+    let mut mass = vec![0.0; parts];
+    for (&l, &a) in labels.iter().zip(areas) {
+        if l >= 0 && (l as usize) < parts {
+            mass[l as usize] += a;
+        }
+    }
+    let mut scores = vec![0.0; d_dst * parts];
+    let mut ws = w.workspace();
+    let scale = 1.0 / (w.unit() * raw);
+    for (r, (col, &m)) in scores.chunks_mut(d_dst).zip(&mass).enumerate() {
+        if m <= 0.0 {
+            continue;
+        }
+        let x: Vec<f64> = labels
+            .iter()
+            .zip(areas)
+            .map(|(&l, &a)| if l == r as i32 { a / m } else { 0.0 })
+            .collect();
+        w.transport(dir, &x, None, col, &mut ws)?;
+        col.iter_mut().for_each(|v| *v *= scale);
+    }
+    Ok(scores)
 }
 
 /// Vote weights are rounded to this many steps per unit, so that a neighbour's small change
@@ -373,8 +448,22 @@ impl Propagation {
             // The changed shape's own votes are stale whatever its labels are now.
             self.vote_labels.retain(|&(j, _), _| j != c);
         }
+        let rule = (options.part_score, options.area_weighted);
+        if rule != self.vote_rule {
+            self.vote_labels.clear();
+            self.votes.clear();
+            self.vote_rule = rule;
+        }
+        // The quick update: one pass, fresh votes from the sources (the changed shape's among
+        // them), the relays of labelled neighbours as cached (from their previous labels).
+        let quick = changed.filter(|_| !options.update_relays);
+        let max_sweeps = if quick.is_some() {
+            0
+        } else {
+            options.max_sweeps
+        };
         let (mut sweeps, mut converged) = (0, false);
-        while sweeps <= options.max_sweeps {
+        while sweeps <= max_sweeps {
             sweeps += 1;
             let mut any = false;
             for &i in &order {
@@ -392,7 +481,13 @@ impl Propagation {
                     .collect();
                 let mut computed = 0;
                 for &(j, _) in &voters {
-                    if self.ensure_vote(graph, j, i)? {
+                    let cached_relay = quick.is_some_and(|c| c != j)
+                        && !self.sources[j]
+                        && self.votes.contains_key(&(j, i));
+                    if cached_relay {
+                        continue;
+                    }
+                    if self.ensure_vote(graph, j, i, options)? {
                         computed += 1;
                     }
                 }
@@ -472,15 +567,48 @@ impl Propagation {
         if psum > 0.0 {
             prior.iter_mut().for_each(|p| *p /= psum);
         }
-        if let Some(s) = smoother {
-            s.smooth(&mut total, np)
-                .map_err(|e| PropagateError::Smoothing {
+        let smooth = |x: &mut Vec<f64>| -> Result<(), PropagateError> {
+            if let Some(s) = smoother {
+                s.smooth(x, np).map_err(|e| PropagateError::Smoothing {
                     name: node.name.clone(),
                     message: e.to_string(),
                 })?;
-        }
+            }
+            Ok(())
+        };
+        smooth(&mut total)?;
         let (mut labels, mut margins) =
             fit_sizes(&total, np, &node.areas, &prior, options.size_prior);
+        if options.refit_rounds > 0 && options.refit_weight > 0.0 {
+            // The label-aware refit: the target's own parts, as its current labels draw them
+            // (annotated vertices included), score its vertices like one more voter.
+            let pairing = graph_pairing(graph, node.bands.features);
+            let w = BandAffinity::with_pairing(&node.bands, &node.bands, &pairing)?;
+            let beta = options.refit_weight;
+            for _ in 0..options.refit_rounds {
+                let mut current = labels.clone();
+                if let Some(a) = &self.annotations[i] {
+                    for (c, &l) in current.iter_mut().zip(a) {
+                        if l >= 0 {
+                            *c = l;
+                        }
+                    }
+                }
+                let mut own = vote_scores(&w, Direction::AtoB, &current, &node.areas, np, options)?;
+                smooth(&mut own)?;
+                let mixed: Vec<f64> = total
+                    .iter()
+                    .zip(&own)
+                    .map(|(t, o)| (t + beta * o) / (1.0 + beta))
+                    .collect();
+                let (l, m) = fit_sizes(&mixed, np, &node.areas, &prior, options.size_prior);
+                let same = l == labels;
+                (labels, margins) = (l, m);
+                if same {
+                    break;
+                }
+            }
+        }
         if let Some(a) = &self.annotations[i] {
             for v in 0..d {
                 if a[v] >= 0 {
@@ -605,4 +733,55 @@ fn fit_sizes(
         scale.iter_mut().for_each(|s| *s /= m);
     }
     result
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bands::equal_count_bands;
+
+    /// The area-weighted transport and the part histograms of `part_scores` are the same
+    /// score (the mean affinity to the part's area density), and with equal areas both equal
+    /// the vertex-count transport.
+    #[test]
+    fn area_weighted_transport_equals_the_area_histogram_score() {
+        let a: Vec<f64> = (0..30)
+            .map(|i| ((i * 7) % 10) as f64 + 0.01 * i as f64)
+            .collect();
+        let b: Vec<f64> = (0..24)
+            .map(|i| ((i * 5) % 8) as f64 - 0.02 * i as f64)
+            .collect();
+        let (ta, tb) = (
+            equal_count_bands(&a, 3, 10, 4).unwrap(),
+            equal_count_bands(&b, 3, 8, 4).unwrap(),
+        );
+        let pairing = FeaturePairing::new(vec![(0, 0), (1, 1), (2, 2)], Some(vec![1.0, 2.0, 5.0]));
+        let w = BandAffinity::with_pairing(&ta, &tb, &pairing).unwrap();
+        let labels: Vec<i32> = (0..10).map(|p| [0, 1, -1, 1, 0][p % 5]).collect();
+        let areas: Vec<f64> = (0..10).map(|p| 0.5 + (p % 3) as f64).collect();
+        let mut o = PropagateOptions {
+            area_weighted: true,
+            ..Default::default()
+        };
+        let t = vote_scores(&w, Direction::AtoB, &labels, &areas, 2, &o).unwrap();
+        let h = part_scores(
+            &w,
+            Direction::AtoB,
+            &labels,
+            Some(&areas),
+            2,
+            PartScore::Affinity,
+        );
+        assert_eq!(t.len(), 16);
+        for (x, y) in t.iter().zip(&h) {
+            assert!((x - y).abs() < 1e-12, "{x} vs {y}");
+        }
+        let ones = vec![1.0; 10];
+        let t1 = vote_scores(&w, Direction::AtoB, &labels, &ones, 2, &o).unwrap();
+        o.area_weighted = false;
+        let c = vote_scores(&w, Direction::AtoB, &labels, &ones, 2, &o).unwrap();
+        for (x, y) in t1.iter().zip(&c) {
+            assert!((x - y).abs() < 1e-12, "{x} vs {y}");
+        }
+    }
 }
