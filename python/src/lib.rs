@@ -10,15 +10,15 @@ use coseg::graph::{SegmentCollectionOptions, ShapeNode, load_collection, segment
 use coseg::labels::{LabelKind, PartNames, read_part_names, read_shape_labels};
 use coseg::maps::PresetChoice;
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
-use coseg::output::{
+use coseg::output::{PropagationSummary, write_propagation, 
     CollectionSummary, PairSummary, ShapeRegions, ShapeSummary, SkippedInput, write_regions,
 };
 use coseg::pipeline::{
     ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
 };
 use coseg::propagate::{
-    PropagateCollectionOptions, PropagateError, PropagatedCollection, PropagationSummary,
-    SourceFile, propagate_collection, propagate_loaded, write_propagation,
+    PropagateCollectionOptions, PropagateError, PropagatedCollection, SourceFile,
+    propagate_collection, propagate_loaded,
 };
 use coseg::shape_task;
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
@@ -568,14 +568,7 @@ fn load_folder(folder: &Path, pipe: &ShapePipelineOptions, cache: &Path) -> Resu
         files: c.paths.iter().map(|p| p.display().to_string()).collect(),
         meshes: c.meshes,
         nodes: c.nodes,
-        skipped: c
-            .skipped
-            .iter()
-            .map(|s| SkippedInput {
-                path: s.path.display().to_string(),
-                error: s.error.clone(),
-            })
-            .collect(),
+        skipped: c.skipped.iter().map(SkippedInput::from).collect(),
         warnings: c.warnings,
         outcomes: c.outcomes.iter().map(outcome).collect(),
     })
@@ -697,13 +690,16 @@ fn label_inputs(list: &Bound<'_, PyList>) -> PyResult<Vec<LabelInput>> {
     Ok(out)
 }
 
+/// Per-shape vertex labels (`None`: unannotated), the sources among them, and warnings.
+type Annotations = (Vec<Option<Vec<i32>>>, Vec<SourceFile>, Vec<String>);
+
 /// The annotations of `shapes` (per vertex, `-1` = unlabelled) and the sources among them, or
 /// the error naming the shape whose labels do not fit it. An annotation without a labelled
 /// vertex is not used (a warning), as `coseg propagate` treats such a file.
 fn annotations_of(
     shapes: &[Shape],
     inputs: Vec<LabelInput>,
-) -> Result<(Vec<Option<Vec<i32>>>, Vec<SourceFile>, Vec<String>), BoxError> {
+) -> Result<Annotations, BoxError> {
     if inputs.len() != shapes.len() {
         return Err(format!(
             "{} label entries for {} shapes (give None for an unlabelled shape)",
@@ -876,14 +872,7 @@ fn propagate<'py>(
     )?;
     d.set_item("sources", summary.sources.clone())?;
     d.set_item("summary", json(py, &summary)?)?;
-    let skipped: Vec<SkippedInput> = result
-        .skipped
-        .iter()
-        .map(|s| SkippedInput {
-            path: s.path.display().to_string(),
-            error: s.error.clone(),
-        })
-        .collect();
+    let skipped: Vec<SkippedInput> = result.skipped.iter().map(SkippedInput::from).collect();
     d.set_item("skipped", json(py, &skipped)?)?;
     d.set_item("warnings", result.warnings.clone())?;
     d.set_item("outcomes", outcomes)?;

@@ -5,10 +5,9 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::graph::GraphOptions;
 use coseg::labels::PartNames;
-use coseg::output::write_visuals;
+use coseg::output::{PropagationSummary, write_propagation, write_visuals};
 use coseg::propagate::{
-    PartScore, PropagateCollectionOptions, PropagateOptions, PropagationSummary,
-    propagate_collection, write_propagation,
+    PartScore, PropagateCollectionOptions, PropagateOptions, propagate_collection,
 };
 use coseg::render::{RenderOptions, RenderShape};
 use std::path::PathBuf;

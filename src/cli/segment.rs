@@ -133,14 +133,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         .iter()
         .map(|p| p.display().to_string())
         .collect();
-    let skipped = loaded
-        .skipped
-        .iter()
-        .map(|s| SkippedInput {
-            path: s.path.display().to_string(),
-            error: s.error.clone(),
-        })
-        .collect();
+    let skipped = loaded.skipped.iter().map(SkippedInput::from).collect();
     let mut summary = CollectionSummary::new(&result, &files, &options, skipped);
     if let Some(a) = &result.adaptive {
         let report = PartsReport::new(a, seg, &loaded.meshes);

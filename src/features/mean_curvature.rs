@@ -1,4 +1,5 @@
-use crate::mesh::{TriMesh, cross, dot, norm, sub};
+use crate::mesh::TriMesh;
+use crate::spectral::SurfaceOperators;
 #[cfg(test)]
 use crate::spectral::cotan_laplacian;
 
@@ -41,35 +42,11 @@ pub fn mean_curvature(mesh: &TriMesh) -> Vec<f64> {
         .collect()
 }
 
-/// Same clamp as [`cotan_laplacian`](crate::spectral::cotan_laplacian) (its `MAX_COTANGENT`).
-const MAX_COTANGENT: f64 = 1e5;
-
-/// `L X` for the cotangent Laplacian `L` of [`cotan_laplacian`](crate::spectral::cotan_laplacian)
-/// (same weights, clamp and degenerate-triangle rule), assembled face by face without building
-/// the sparse matrix: `(L X)_i = Σ_j w_ij (x_i − x_j)`.
+/// `L X` for the cotangent Laplacian `L` of the mesh's [`SurfaceOperators`] (the same
+/// weights, clamp and degenerate-triangle rule as the spectrum's), assembled face by face
+/// without building the sparse matrix: `(L X)_i = Σ_j w_ij (x_i − x_j)`.
 pub(crate) fn cotan_laplacian_times_positions(mesh: &TriMesh) -> Vec<[f64; 3]> {
-    let x = mesh.positions();
-    let mut lx = vec![[0.0f64; 3]; mesh.vertex_count()];
-    for (f, idx) in mesh.faces().iter().enumerate() {
-        let p = mesh.corners(f);
-        for k in 0..3 {
-            let (i, j) = ((k + 1) % 3, (k + 2) % 3);
-            let u = sub(p[i], p[k]);
-            let v = sub(p[j], p[k]);
-            let c = norm(cross(u, v));
-            if c.partial_cmp(&0.0) != Some(std::cmp::Ordering::Greater) {
-                continue;
-            }
-            let w = 0.5 * (dot(u, v) / c).clamp(-MAX_COTANGENT, MAX_COTANGENT);
-            let (a, b) = (idx[i] as usize, idx[j] as usize);
-            for c in 0..3 {
-                let e = w * (x[a][c] - x[b][c]);
-                lx[a][c] += e;
-                lx[b][c] -= e;
-            }
-        }
-    }
-    lx
+    SurfaceOperators::new(mesh).laplacian_times(mesh, mesh.positions())
 }
 
 /// Mixed Voronoi vertex areas (Meyer, Desbrun, Schröder, Barr 2003): the Voronoi area inside
@@ -118,6 +95,80 @@ fn mixed_voronoi_areas(mesh: &TriMesh) -> Vec<f64> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `L X` by the face loop against the sparse `L` times `X`, to rounding.
+    fn assert_face_loop_matches_sparse(mesh: &TriMesh) {
+        let lx = cotan_laplacian_times_positions(mesh);
+        let l = cotan_laplacian(mesh);
+        // Rounding of the two summation orders grows with the weights (cancellation of
+        // w·x_i − w·x_j): bound it by the largest entry of L times the largest coordinate.
+        let big_w = l.val().iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let big_x = mesh
+            .positions()
+            .iter()
+            .flatten()
+            .fold(0.0f64, |a, v| a.max(v.abs()));
+        let scale = (big_w * big_x).max(1.0);
+        for (j, got) in lx.iter().enumerate() {
+            let rows = l.as_ref().row_idx_of_col_raw(j);
+            let vals = l.as_ref().val_of_col(j);
+            let mut want = [0.0; 3];
+            for (&i, &w) in rows.iter().zip(vals) {
+                for (c, out) in want.iter_mut().enumerate() {
+                    *out += w * mesh.positions()[i][c];
+                }
+            }
+            for c in 0..3 {
+                assert!(
+                    (got[c] - want[c]).abs() <= 1e-12 * scale,
+                    "{j} {c}: {got:?} {want:?}"
+                );
+            }
+        }
+    }
+
+    /// Regression (one house, #15): the curvature clamped each cotangent apart and skipped
+    /// single corners, while the Laplacian of the spectrum scales a needle triangle's three
+    /// cotangents together and drops a degenerate triangle whole. On a needle (angles ~2e-7,
+    /// cotangents ~5e6) and a zero-area triangle the two gave different `L X`.
+    #[test]
+    fn regression_needle_and_zero_area_triangles_follow_the_laplacians_rule() {
+        let mesh = TriMesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.2],
+                [0.5, 1e-7, 0.1],
+                [0.5, 0.8, 0.6],
+                [2.0, 0.0, 0.4],
+                [0.4, -0.7, -0.3],
+            ],
+            // 0-1-2 is the needle (vertex 2 lies 1e-7 off the segment 0-1); the other faces
+            // are regular.
+            vec![
+                [0, 1, 2],
+                [0, 2, 3],
+                [2, 1, 3],
+                [1, 4, 3],
+                [0, 5, 1],
+                [0, 1, 4],
+            ],
+        )
+        .unwrap();
+        assert_face_loop_matches_sparse(&mesh);
+        // Exactly collinear corners: a zero-area triangle beside regular ones.
+        let flat = TriMesh::new(
+            vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [2.0, 0.0, 0.0],
+                [1.0, 1.0, 0.5],
+                [1.0, -1.0, 0.3],
+            ],
+            vec![[0, 1, 2], [0, 1, 3], [1, 2, 3], [1, 0, 4], [2, 1, 4]],
+        )
+        .unwrap();
+        assert_face_loop_matches_sparse(&flat);
+    }
 
     #[test]
     fn face_assembly_equals_the_sparse_laplacian() {

@@ -60,6 +60,15 @@ pub struct SkippedInput {
     pub error: String,
 }
 
+impl From<&crate::graph::SkippedFile> for SkippedInput {
+    fn from(s: &crate::graph::SkippedFile) -> Self {
+        SkippedInput {
+            path: s.path.display().to_string(),
+            error: s.error.clone(),
+        }
+    }
+}
+
 /// Contents of `summary.json` for `coseg segment`. Holds no timings, so that the same inputs
 /// and options give the same file, byte for byte.
 #[derive(Debug, Clone, Serialize)]

@@ -1,4 +1,5 @@
-//! Output files of a segmentation: per-vertex region ids, coloured meshes and a JSON summary.
+//! Output files of a segmentation or a propagation: per-vertex region ids or labels, coloured
+//! meshes and a JSON summary ([`write_regions`], [`write_propagation`], [`write_visuals`]).
 //!
 //! Generic over the stage that produced the regions (two-shape stable regions or a collection):
 //! a shape is a name, its mesh and one region id per vertex (`-1` = none); the summary is any
@@ -18,6 +19,7 @@ mod export_features;
 mod pair_summary;
 mod viewer;
 mod visuals;
+mod write_propagation;
 mod write_regions;
 
 /// Re-exported from [`crate::render`], where the palette lives: PLY colours and pictures agree.
@@ -29,6 +31,9 @@ pub use export_features::{ExportFormat, ExportOptions, export_features};
 pub use pair_summary::{PairSummary, RegionSummary, ShapeSummary};
 pub use viewer::write_viewer;
 pub use visuals::write_visuals;
+pub use write_propagation::{
+    PropagatedPart, PropagatedShape, PropagationSummary, write_propagation,
+};
 pub use write_regions::{
     ShapeRegions, write_region_ids, write_region_mesh, write_regions, write_summary,
 };
@@ -69,6 +74,9 @@ pub enum OutputError {
     /// Drawing or writing a picture failed.
     #[error(transparent)]
     Render(#[from] crate::render::RenderError),
+    /// Label files could not be written or converted.
+    #[error(transparent)]
+    Labels(#[from] crate::labels::LabelError),
     /// The summary could not be serialised.
     #[error("summary.json: {0}")]
     Json(String),

@@ -7,7 +7,7 @@
 //! - [`Propagation::update`]: add or correct one annotation and re-propagate from the previous
 //!   state, reusing every transport whose voter did not change.
 //! - [`propagate_collection`]: a folder of meshes and a folder (or list) of label files in
-//!   one call, as `coseg propagate` runs it; [`write_propagation`] writes its files.
+//!   one call, as `coseg propagate` runs it; [`crate::output::write_propagation`] writes its files.
 //!   [`propagate_loaded`] is its collection stage alone, for shapes already in memory (the
 //!   Python package's `coseg.propagate` on arrays).
 
@@ -15,7 +15,6 @@ mod collection;
 mod options;
 mod part_scores;
 mod solve;
-mod write;
 
 pub use collection::{
     PropagateCollectionOptions, PropagatedCollection, PropagatedShapes, SourceFile,
@@ -24,7 +23,6 @@ pub use collection::{
 pub use options::PropagateOptions;
 pub use part_scores::{GEOMETRIC_FLOOR, PartScore};
 pub use solve::{Propagation, UpdateStats, propagate_labels};
-pub use write::{PropagationSummary, write_propagation};
 
 use thiserror::Error;
 
@@ -65,7 +63,4 @@ pub enum PropagateError {
     /// A label file is unreadable or does not fit its mesh.
     #[error(transparent)]
     Labels(#[from] crate::labels::LabelError),
-    /// Writing an output failed.
-    #[error(transparent)]
-    Output(#[from] crate::output::OutputError),
 }

@@ -1,4 +1,4 @@
-use super::{SpectralError, cotan_laplacian};
+use super::{SpectralError, SurfaceOperators};
 use crate::mesh::TriMesh;
 use faer::linalg::solvers::Solve;
 use faer::sparse::linalg::solvers::Llt;
@@ -38,13 +38,21 @@ pub struct HeatSmoother {
 impl HeatSmoother {
     /// Factorises `M + t L` for `mesh` (scaled to unit area) and time `time > 0`.
     pub fn new(mesh: &TriMesh, time: f64) -> Result<Self, SpectralError> {
+        Self::from_operators(&SurfaceOperators::new(mesh), time)
+    }
+
+    /// Same as [`HeatSmoother::new`], from operators already computed for the mesh.
+    pub fn from_operators(ops: &SurfaceOperators, time: f64) -> Result<Self, SpectralError> {
         if !(time.is_finite() && time > 0.0) {
             return Err(SpectralError::InvalidOption(format!(
                 "heat smoothing time must be positive and finite, got {time}"
             )));
         }
-        let d = mesh.vertex_count();
-        let areas = mesh.vertex_areas();
+        let d = ops.vertex_count();
+        // Normalised by the sum of the lumped masses (not the sum of the face areas the
+        // spectrum divides by; the two differ in the last bits): `Σ M = 1` on this matrix, and
+        // every smoothed output is unchanged from before the operators were shared.
+        let areas = ops.vertex_areas();
         let total: f64 = areas.iter().sum();
         if !(total.is_finite() && total > 0.0) {
             return Err(SpectralError::InvalidOption(
@@ -53,8 +61,7 @@ impl HeatSmoother {
         }
         let floor = 1e-9 / d as f64;
         let mass: Vec<f64> = areas.iter().map(|a| (a / total).max(floor)).collect();
-        let l = cotan_laplacian(mesh);
-        let lr = l.as_ref();
+        let lr = ops.laplacian().as_ref();
         let mut triplets = Vec::with_capacity(lr.compute_nnz() + d);
         for (v, &m) in mass.iter().enumerate() {
             triplets.push(Triplet::new(v, v, m));

@@ -1,6 +1,6 @@
 use super::block_lanczos::{BlockLanczosParams, largest_eigenpairs};
 use super::shift_invert::{Pencil, ShiftInvert, count_below};
-use super::{SpectralError, Spectrum, cotan_laplacian, lumped_mass};
+use super::{SpectralError, Spectrum, SurfaceOperators, lumped_mass};
 use crate::mesh::TriMesh;
 use faer::reborrow::*;
 use faer::{Mat, Par};
@@ -206,13 +206,9 @@ pub fn laplace_beltrami_spectrum_with_stats(
             vertices: d,
         });
     }
-    let original_area = mesh.total_area();
-    let mass: Vec<f64> = lumped_mass(mesh)
-        .iter()
-        .map(|m| m / original_area)
-        .collect();
-    let l = cotan_laplacian(mesh);
-    let pencil = Pencil::new(&l, &mass)?;
+    let ops = SurfaceOperators::new(mesh);
+    let (original_area, mass) = (ops.total_area(), ops.unit_mass().to_vec());
+    let pencil = Pencil::new(ops.laplacian(), &mass)?;
     let n = pencil.n();
     if k > n {
         return Err(SpectralError::TooManyEigenpairs {
@@ -556,13 +552,8 @@ pub fn dense_spectrum(mesh: &TriMesh, k: usize) -> Result<Spectrum, SpectralErro
             vertices: d,
         });
     }
-    let original_area = mesh.total_area();
-    // L is scale invariant; M scales with area, so unit area means M / A.
-    let mass: Vec<f64> = lumped_mass(mesh)
-        .iter()
-        .map(|m| m / original_area)
-        .collect();
-    let l = cotan_laplacian(mesh);
+    let ops = SurfaceOperators::new(mesh);
+    let (original_area, mass, l) = (ops.total_area(), ops.unit_mass().to_vec(), ops.laplacian());
     let inv_sqrt: Vec<f64> = mass
         .iter()
         .map(|&m| if m > 0.0 { 1.0 / m.sqrt() } else { 0.0 })
@@ -630,9 +621,8 @@ mod tests {
     fn inertia_check_accepts_the_true_spectrum_and_catches_a_skipped_eigenvalue() {
         let mesh = bumpy_mesh();
         let exact = dense_spectrum(&mesh, 30).unwrap();
-        let area = mesh.total_area();
-        let mass: Vec<f64> = lumped_mass(&mesh).iter().map(|m| m / area).collect();
-        let pencil = Pencil::new(&cotan_laplacian(&mesh), &mass).unwrap();
+        let ops = SurfaceOperators::new(&mesh);
+        let pencil = Pencil::new(ops.laplacian(), ops.unit_mass()).unwrap();
         let symbolic = pencil.symbolic().unwrap();
         let (_, c) = pencil.components();
         assert_eq!(c, 1);

@@ -1,6 +1,9 @@
 //! The Laplace–Beltrami spectrum of a triangle mesh: cotangent Laplacian `L`, lumped mass `M`,
 //! and the smallest eigenpairs of `L φ = λ M φ`.
 //!
+//! Entry points: [`SurfaceOperators`] (a mesh's Laplacian, unit-area mass and cotangent weights,
+//! under one rule), [`laplace_beltrami_spectrum`], [`HeatSmoother`].
+//!
 //! Every spectrum coseg computes is that of the mesh **scaled to unit total area**, so that
 //! eigenvalues, diffusion times and energies mean the same on every shape of a collection,
 //! whatever the units of its file. Eigenvectors are M-orthonormal for the unit-area mass.
@@ -11,6 +14,7 @@ mod heat_smoother;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
 mod shift_invert;
+mod surface_operators;
 
 pub use cotan_laplacian::cotan_laplacian;
 pub use heat_smoother::HeatSmoother;
@@ -19,6 +23,7 @@ pub use laplace_beltrami_spectrum::{
     laplace_beltrami_spectrum, laplace_beltrami_spectrum_with_stats,
 };
 pub use lumped_mass::lumped_mass;
+pub use surface_operators::{MAX_COTANGENT, SurfaceOperators};
 
 use thiserror::Error;
 

@@ -1,16 +1,16 @@
 //! [`write_propagation`]: label files, coloured meshes and `summary.json` of a propagation.
 
-use super::{PropagateError, PropagateOptions, PropagatedCollection};
+use super::{OutputError, region_colors, write_summary};
 use crate::graph::GraphOptions;
 use crate::labels::{LabelKind, vertices_to_faces, write_face_labels, write_vertex_labels};
 use crate::mesh::{PlyVertexProperty, write_mesh};
-use crate::output::{region_colors, write_summary};
+use crate::propagate::{PropagateOptions, PropagatedCollection};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-/// One part in `summary.json`.
+/// One part in the `summary.json` of a propagation.
 #[derive(Debug, Clone, Serialize)]
-pub struct PartSummary {
+pub struct PropagatedPart {
     /// The label.
     pub label: i32,
     /// Its name from the part-names file, if any.
@@ -21,9 +21,9 @@ pub struct PartSummary {
     pub confidence: f64,
 }
 
-/// One shape in `summary.json`.
+/// One shape in the `summary.json` of a propagation.
 #[derive(Debug, Clone, Serialize)]
-pub struct ShapeSummary {
+pub struct PropagatedShape {
     /// Output name (file stem).
     pub name: String,
     /// Input mesh file.
@@ -37,7 +37,7 @@ pub struct ShapeSummary {
     /// Area-weighted mean per-vertex confidence.
     pub confidence: f64,
     /// Per part present in the collection.
-    pub parts: Vec<PartSummary>,
+    pub parts: Vec<PropagatedPart>,
 }
 
 /// `summary.json` of `coseg propagate`: no timings, so reruns give the same bytes.
@@ -50,9 +50,9 @@ pub struct PropagationSummary {
     /// Names of the source shapes.
     pub sources: Vec<String>,
     /// Every shape, graph order.
-    pub shapes: Vec<ShapeSummary>,
+    pub shapes: Vec<PropagatedShape>,
     /// Every part over the collection (mean area share and confidence over the shapes).
-    pub parts: Vec<PartSummary>,
+    pub parts: Vec<PropagatedPart>,
     /// Sweeps of the solver and whether the last changed nothing.
     pub sweeps: usize,
     /// Whether the last sweep changed no label.
@@ -71,10 +71,10 @@ impl PropagationSummary {
         let p = &c.propagation;
         let name_of = |l: i32| c.part_names.get(&l).cloned();
         let n = c.graph.node_count();
-        let shapes: Vec<ShapeSummary> = (0..n)
+        let shapes: Vec<PropagatedShape> = (0..n)
             .map(|i| {
                 let src = c.sources.iter().find(|s| s.shape == i);
-                ShapeSummary {
+                PropagatedShape {
                     name: c.graph.node(i).name.clone(),
                     file: c.paths[i].display().to_string(),
                     vertices: c.graph.node(i).bands.vertices,
@@ -85,7 +85,7 @@ impl PropagationSummary {
                         .parts
                         .iter()
                         .enumerate()
-                        .map(|(r, &l)| PartSummary {
+                        .map(|(r, &l)| PropagatedPart {
                             label: l,
                             name: name_of(l),
                             area_fraction: p.part_shares[i][r],
@@ -102,7 +102,7 @@ impl PropagationSummary {
             .map(|(r, &l)| {
                 let present: Vec<usize> = (0..n).filter(|&i| p.part_shares[i][r] > 0.0).collect();
                 let k = present.len().max(1) as f64;
-                PartSummary {
+                PropagatedPart {
                     label: l,
                     name: name_of(l),
                     area_fraction: (0..n).map(|i| p.part_shares[i][r]).sum::<f64>() / n as f64,
@@ -141,12 +141,15 @@ impl PropagationSummary {
 /// `<name>.seg` (per face, [`vertices_to_faces`]) and `<name>.labels.ply` (coloured by label,
 /// integer `label` vertex property), then `summary.json`. Every file is written atomically.
 /// Returns the written paths.
+///
+/// See also [`crate::propagate::propagate_collection`], which makes `c`; docs/OUTPUTS.md
+/// describes the files.
 pub fn write_propagation(
     dir: &Path,
     c: &PropagatedCollection,
     summary: &PropagationSummary,
-) -> Result<Vec<PathBuf>, PropagateError> {
-    std::fs::create_dir_all(dir).map_err(|source| crate::output::OutputError::Io {
+) -> Result<Vec<PathBuf>, OutputError> {
+    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
         path: dir.display().to_string(),
         source,
     })?;
@@ -168,8 +171,7 @@ pub fn write_propagation(
                 PlyVertexProperty::Color(region_colors(labels)),
                 PlyVertexProperty::Int("label".into(), labels.clone()),
             ],
-        )
-        .map_err(crate::output::OutputError::from)?;
+        )?;
         out.push(ply);
     }
     out.push(write_summary(dir, summary)?);

@@ -1,0 +1,175 @@
+//! [`SurfaceOperators`]: the cotangent weights, Laplacian and unit-area mass of one mesh, under
+//! one rule for clamped and degenerate triangles, shared by the spectrum, the heat smoother
+//! and the mean curvature.
+
+use crate::mesh::{TriMesh, cross, dot, norm, sub};
+use faer::sparse::{SparseColMat, Triplet};
+
+/// Largest magnitude allowed for a cotangent weight. Nearly degenerate triangles have
+/// unbounded cotangents; when one of a triangle's cotangents exceeds this, all three are scaled
+/// down by the same factor (which keeps `L` positive semi-definite), bounding `L`'s entries at
+/// the price of a local error on those triangles only. Degenerate (zero-area) triangles
+/// contribute nothing.
+pub const MAX_COTANGENT: f64 = 1e5;
+
+/// The surface operators of one mesh (`d` vertices, `F` faces), computed once and shared by
+/// every algorithm that needs them ([`crate::spectral::laplace_beltrami_spectrum`],
+/// [`crate::spectral::HeatSmoother`], [`crate::features::mean_curvature`]):
+///
+/// - `half_cotangents`: `F × 3`, `cot(θ_k) / 2` of the angle at corner `k` of each face (the
+///   weight of the opposite edge `(k+1, k+2)`), under **the one rule** of this crate: a face
+///   with a corner of zero, negative or non-finite `|u × v|` is degenerate and gets three
+///   zeros; a face whose largest `|cot|` exceeds [`MAX_COTANGENT`] has all three scaled by the
+///   same factor (keeps each face's stiffness matrix positive semi-definite, whereas clamping
+///   each cotangent apart can make a needle triangle indefinite);
+/// - `laplacian`: `d × d`, the weak cotangent Laplacian `L` assembled from those weights,
+///   `L_ij = −Σ half-cotangents of edge ij`, `L_ii = −Σ_j L_ij` (so `L 1 = 0`), symmetric
+///   positive semi-definite, dimensionless (the same for the mesh scaled to unit area);
+/// - `vertex_areas`: length `d`, the barycentric (lumped) vertex areas as read;
+/// - `unit_mass`: length `d`, the barycentric (lumped) vertex areas of the mesh scaled to
+///   unit total area (they sum to 1 up to rounding; unreferenced vertices get 0);
+/// - `total_area`: the mesh's area as read, squared file units.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, spectral::SurfaceOperators};
+/// let m = TriMesh::new(vec![[0.,0.,0.],[2.,0.,0.],[2.,2.,0.],[0.,2.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
+/// let ops = SurfaceOperators::new(&m);
+/// assert_eq!(ops.total_area(), 4.0);
+/// assert!((ops.unit_mass().iter().sum::<f64>() - 1.0).abs() < 1e-15);
+/// assert_eq!(ops.laplacian().nrows(), 4);
+/// ```
+///
+/// See also [`crate::spectral::cotan_laplacian`], [`crate::spectral::lumped_mass`].
+#[derive(Debug, Clone)]
+pub struct SurfaceOperators {
+    half_cotangents: Vec<[f64; 3]>,
+    laplacian: SparseColMat<usize, f64>,
+    vertex_areas: Vec<f64>,
+    unit_mass: Vec<f64>,
+    total_area: f64,
+}
+
+impl SurfaceOperators {
+    /// Computes the operators of `mesh`: O(F) time and memory.
+    pub fn new(mesh: &TriMesh) -> Self {
+        let half_cotangents = half_cotangents(mesh);
+        let laplacian = assemble(mesh, &half_cotangents);
+        let total_area = mesh.total_area();
+        let vertex_areas = mesh.vertex_areas();
+        let unit_mass = vertex_areas.iter().map(|m| m / total_area).collect();
+        SurfaceOperators {
+            half_cotangents,
+            laplacian,
+            vertex_areas,
+            unit_mass,
+            total_area,
+        }
+    }
+
+    /// `cot(θ_k) / 2` per face corner (`F × 3`), under the rule stated on the type.
+    pub fn half_cotangents(&self) -> &[[f64; 3]] {
+        &self.half_cotangents
+    }
+
+    /// The cotangent Laplacian `L` (`d × d`).
+    pub fn laplacian(&self) -> &SparseColMat<usize, f64> {
+        &self.laplacian
+    }
+
+    /// Lumped (barycentric) vertex areas of the mesh as read (length `d`, squared file units).
+    pub fn vertex_areas(&self) -> &[f64] {
+        &self.vertex_areas
+    }
+
+    /// Lumped mass of the unit-area mesh (length `d`): [`Self::vertex_areas`] over
+    /// [`Self::total_area`].
+    pub fn unit_mass(&self) -> &[f64] {
+        &self.unit_mass
+    }
+
+    /// Total area of the mesh as read (squared file units).
+    pub fn total_area(&self) -> f64 {
+        self.total_area
+    }
+
+    /// Number of vertices `d`.
+    pub fn vertex_count(&self) -> usize {
+        self.unit_mass.len()
+    }
+
+    /// `L X` for `d` points `X` (e.g. the vertex positions), assembled face by face from the
+    /// same weights as [`Self::laplacian`] without a sparse product: `(L X)_i = Σ_j w_ij (x_i −
+    /// x_j)`. `mesh` must be the mesh the operators were built from.
+    pub fn laplacian_times(&self, mesh: &TriMesh, x: &[[f64; 3]]) -> Vec<[f64; 3]> {
+        let mut lx = vec![[0.0f64; 3]; x.len()];
+        for (idx, w) in mesh.faces().iter().zip(&self.half_cotangents) {
+            for (k, &wk) in w.iter().enumerate() {
+                if wk == 0.0 {
+                    continue;
+                }
+                let (a, b) = (idx[(k + 1) % 3] as usize, idx[(k + 2) % 3] as usize);
+                for c in 0..3 {
+                    let e = wk * (x[a][c] - x[b][c]);
+                    lx[a][c] += e;
+                    lx[b][c] -= e;
+                }
+            }
+        }
+        lx
+    }
+}
+
+/// The cotangent Laplacian alone (see [`super::cotan_laplacian`]).
+pub(super) fn laplacian(mesh: &TriMesh) -> SparseColMat<usize, f64> {
+    assemble(mesh, &half_cotangents(mesh))
+}
+
+/// The per-corner half-cotangents of every face under the rule of [`SurfaceOperators`].
+fn half_cotangents(mesh: &TriMesh) -> Vec<[f64; 3]> {
+    (0..mesh.face_count())
+        .map(|f| {
+            let p = mesh.corners(f);
+            // Cotangent of the angle at each corner k, opposite edge (k+1, k+2).
+            let mut cot = [0.0f64; 3];
+            for (k, ck) in cot.iter_mut().enumerate() {
+                let u = sub(p[(k + 1) % 3], p[k]);
+                let v = sub(p[(k + 2) % 3], p[k]);
+                let c = norm(cross(u, v));
+                if c.is_nan() || c <= 0.0 || !c.is_finite() {
+                    return [0.0; 3];
+                }
+                *ck = dot(u, v) / c;
+            }
+            // One factor for the three (c₀c₁ + c₁c₂ + c₂c₀ = 1 > 0 survives a common positive
+            // factor; a separate clamp per corner does not).
+            let big = cot.iter().fold(0.0f64, |a, c| a.max(c.abs()));
+            if big > MAX_COTANGENT {
+                let s = MAX_COTANGENT / big;
+                for c in cot.iter_mut() {
+                    *c *= s;
+                }
+            }
+            cot.map(|c| 0.5 * c)
+        })
+        .collect()
+}
+
+fn assemble(mesh: &TriMesh, half_cotangents: &[[f64; 3]]) -> SparseColMat<usize, f64> {
+    let d = mesh.vertex_count();
+    let mut triplets = Vec::with_capacity(mesh.face_count() * 12);
+    for (idx, w) in mesh.faces().iter().zip(half_cotangents) {
+        if *w == [0.0; 3] {
+            continue;
+        }
+        for (k, &wk) in w.iter().enumerate() {
+            let (a, b) = (idx[(k + 1) % 3] as usize, idx[(k + 2) % 3] as usize);
+            triplets.push(Triplet::new(a, b, -wk));
+            triplets.push(Triplet::new(b, a, -wk));
+            triplets.push(Triplet::new(a, a, wk));
+            triplets.push(Triplet::new(b, b, wk));
+        }
+    }
+    // Duplicate entries are summed by the constructor.
+    SparseColMat::try_new_from_triplets(d, d, &triplets)
+        .expect("indices are in range by TriMesh's invariants")
+}
