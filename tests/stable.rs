@@ -3,7 +3,7 @@
 mod common;
 
 use common::stable::{noisy_copy, random_table, random_vec};
-use coseg::affinity::{BandAffinity, dense_affinity};
+use coseg::affinity::{BandAffinity, Direction, dense_affinity};
 use coseg::stable::{
     Remaining, StablePairOptions, Threshold, ThresholdScratch, stable_pair, threshold,
 };
@@ -1165,5 +1165,82 @@ mod preset {
             map_preset(&sa, &short).unwrap().preset,
             MapPreset::NearIsometric
         );
+    }
+}
+
+/// `t` with its feature columns reordered by a seeded permutation (the same for every table
+/// given the same seed and feature count).
+fn features_permuted(t: &BandTable, seed: u64) -> BandTable {
+    let x = random_vec(t.features, seed);
+    let mut order: Vec<usize> = (0..t.features).collect();
+    order.sort_by(|&i, &j| x[i].total_cmp(&x[j]));
+    let mut labels = vec![0u8; t.labels.len()];
+    for v in 0..t.vertices {
+        let row = t.row(v);
+        for (k, &old) in order.iter().enumerate() {
+            labels[v * t.features + k] = row[old];
+        }
+    }
+    BandTable {
+        labels,
+        ..t.clone()
+    }
+}
+
+/// Exact invariance (#15): the affinity is a sum over features of integer band-match counts,
+/// so reordering the features of both shapes alike must leave Algorithms 2 and 3 unchanged bit
+/// for bit, pairs, objectives and thresholds included, whatever the start.
+#[test]
+fn stable_regions_are_exactly_invariant_to_the_order_of_features() {
+    let (a, b) = (
+        latent_table(1500, 24, 10, 31),
+        latent_table(1600, 24, 10, 32),
+    );
+    let (pa, pb) = (features_permuted(&a, 33), features_permuted(&b, 33));
+    assert_ne!(a.labels, pa.labels, "the permutation must move something");
+    let areas_a: Vec<f64> = random_vec(1500, 34).iter().map(|x| 0.5 + x).collect();
+    let areas_b: Vec<f64> = random_vec(1600, 35).iter().map(|x| 0.5 + x).collect();
+    for algorithm in [Algorithm::Fixed, Algorithm::Auto] {
+        for init in [Init::Extreme, Init::Random] {
+            let opts = StableRegionsOptions {
+                algorithm,
+                init,
+                ..Default::default()
+            };
+            let r = stable_regions(&a, &b, &areas_a, &areas_b, &opts).unwrap();
+            let p = stable_regions(&pa, &pb, &areas_a, &areas_b, &opts).unwrap();
+            assert_eq!(r, p, "{algorithm:?} {init:?}");
+        }
+    }
+}
+
+/// Exact equivariance (#15): renumbering the vertices of A by `π` and of B by `σ` renumbers the
+/// transported scores of an indicator accordingly, both ways, to the last bit (the scores are
+/// integer counts).
+#[test]
+fn indicator_transport_is_exactly_equivariant_under_vertex_renumbering() {
+    let (a, b) = (random_table(700, 30, 12, 41), random_table(900, 30, 12, 42));
+    let ((a2, pi), (b2, sigma)) = (permuted(&a, 43), permuted(&b, 44));
+    let (w, w2) = (
+        BandAffinity::new(&a, &b).unwrap(),
+        BandAffinity::new(&a2, &b2).unwrap(),
+    );
+    let mut ws = w.workspace();
+    let x = random_vec(900, 45);
+    for (dir, src_map, dst_map, n_src, n_dst) in [
+        (Direction::AtoB, &pi, &sigma, 700, 900),
+        (Direction::BtoA, &sigma, &pi, 900, 700),
+    ] {
+        let support: Vec<u32> = (0..n_src as u32).filter(|&v| x[v as usize] < 0.3).collect();
+        let mut moved: Vec<u32> = support.iter().map(|&v| src_map[v as usize]).collect();
+        moved.sort_unstable();
+        let (mut out, mut out2) = (vec![0.0; n_dst], vec![0.0; n_dst]);
+        w.transport_indicator(dir, &support, None, &mut out, &mut ws)
+            .unwrap();
+        w2.transport_indicator(dir, &moved, None, &mut out2, &mut ws)
+            .unwrap();
+        for q in 0..n_dst {
+            assert_eq!(out2[dst_map[q] as usize], out[q], "{dir:?} vertex {q}");
+        }
     }
 }
