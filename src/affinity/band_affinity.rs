@@ -1,6 +1,7 @@
 //! [`BandAffinity`]: `W x` and `Wᵀ y` through per-feature band histograms.
 
 use super::AffinityError;
+use super::kernel::{Bin, row_sum};
 use crate::bands::BandTable;
 use rayon::prelude::*;
 
@@ -735,68 +736,27 @@ fn scatter_f64(src: &BandTable, bands: usize, support: &[u32], x: &[f64], hist: 
     }
 }
 
-/// A histogram entry type the gather sums.
-trait Bin: Copy + Send + Sync {
-    type Acc: Copy + Default + std::ops::Add<Output = Self::Acc>;
-    fn widen(self) -> Self::Acc;
+/// A table entry [`gather`] sums, and how its sum becomes an `f64`.
+trait Gathered: Bin {
     fn finish(a: Self::Acc) -> f64;
 }
 
-impl Bin for u32 {
-    type Acc = u64;
-    #[inline(always)]
-    fn widen(self) -> u64 {
-        self as u64
-    }
+impl Gathered for u32 {
     #[inline(always)]
     fn finish(a: u64) -> f64 {
         a as f64
     }
 }
 
-impl Bin for f64 {
-    type Acc = f64;
-    #[inline(always)]
-    fn widen(self) -> f64 {
-        self
-    }
+impl Gathered for f64 {
     #[inline(always)]
     fn finish(a: f64) -> f64 {
         a
     }
 }
 
-/// Sum of `table[k*K + row[k]]` over `k` with four independent accumulators (fixed order).
-#[inline(always)]
-fn row_sum<T: Bin>(table: &[T], row: &[u8], bands: usize) -> f64 {
-    debug_assert_eq!(table.len(), row.len() * bands);
-    let mut acc = [T::Acc::default(); 4];
-    let quads = row.len() / 4;
-    // SAFETY: labels are < bands (validated at construction) and table.len() == N * bands, so
-    // every index `k * bands + row[k]` with `k < row.len()` is in bounds.
-    unsafe {
-        for i in 0..quads {
-            let k = 4 * i;
-            for (j, a) in acc.iter_mut().enumerate() {
-                let kk = k + j;
-                *a = *a
-                    + table
-                        .get_unchecked(kk * bands + *row.get_unchecked(kk) as usize)
-                        .widen();
-            }
-        }
-        for kk in 4 * quads..row.len() {
-            acc[0] = acc[0]
-                + table
-                    .get_unchecked(kk * bands + *row.get_unchecked(kk) as usize)
-                    .widen();
-        }
-    }
-    T::finish((acc[0] + acc[1]) + (acc[2] + acc[3]))
-}
-
 /// `out[i] = Σ_k table[k*K + band_dst[k][rows[i]]]` (or over all destination vertices).
-fn gather<T: Bin>(
+fn gather<T: Gathered>(
     dst: &BandTable,
     bands: usize,
     table: &[T],
@@ -811,7 +771,7 @@ fn gather<T: Bin>(
                 .zip(dst.labels.par_chunks(GATHER_BLOCK * nf))
                 .for_each(|(o, labels)| {
                     for (v, row) in o.iter_mut().zip(labels.chunks_exact(nf)) {
-                        *v = post(row_sum(table, row, bands));
+                        *v = post(T::finish(row_sum(table, row, bands)));
                     }
                 });
         }
@@ -820,7 +780,7 @@ fn gather<T: Bin>(
                 .zip(r.par_chunks(GATHER_BLOCK))
                 .for_each(|(o, idx)| {
                     for (v, &q) in o.iter_mut().zip(idx) {
-                        *v = post(row_sum(table, dst.row(q as usize), bands));
+                        *v = post(T::finish(row_sum(table, dst.row(q as usize), bands)));
                     }
                 });
         }
@@ -851,24 +811,7 @@ fn build_pair_table(table: &[u32], features: usize, k: usize, t2: &mut [u32]) {
 /// Sum of `t2[i K² + pl[i]]` with four accumulators.
 #[inline(always)]
 fn pair_row_sum(t2: &[u32], pl: &[u16], kk: usize) -> f64 {
-    debug_assert_eq!(t2.len(), pl.len() * kk);
-    let mut acc = [0u64; 4];
-    let quads = pl.len() / 4;
-    // SAFETY: pair labels are built as `l0 K + l1` from labels `< K` (validated at construction),
-    // so `pl[i] < K² = kk` and `i kk + pl[i] < pl.len() kk = t2.len()`.
-    unsafe {
-        for q in 0..quads {
-            let i = 4 * q;
-            for (j, a) in acc.iter_mut().enumerate() {
-                let ii = i + j;
-                *a += *t2.get_unchecked(ii * kk + *pl.get_unchecked(ii) as usize) as u64;
-            }
-        }
-        for ii in 4 * quads..pl.len() {
-            acc[0] += *t2.get_unchecked(ii * kk + *pl.get_unchecked(ii) as usize) as u64;
-        }
-    }
-    ((acc[0] + acc[1]) + (acc[2] + acc[3])) as f64
+    row_sum(t2, pl, kk) as f64
 }
 
 /// The paired integer gather (see [`gather`]).

@@ -13,6 +13,7 @@
 
 mod band_affinity;
 mod dense_affinity;
+pub(crate) mod kernel;
 
 pub use band_affinity::{
     AffinityWorkspace, BandAffinity, Direction, FeaturePairing, IndicatorHistogram,

@@ -52,6 +52,7 @@ use super::shape_graph::ShapeGraph;
 use super::stable_cycle::{CycleShape, CycleStep};
 use super::{GraphError, cycle_consistency};
 use crate::affinity::BandAffinity;
+use crate::affinity::kernel::row_sum;
 use crate::stable::{Threshold, threshold};
 use crate::vertex_sets::{intersect_sorted, remove_sorted};
 use rand_chacha::ChaCha8Rng;
@@ -345,7 +346,7 @@ impl<'g> Engine<'g> {
             .zip(list.par_chunks(512))
             .for_each(|(o, idx)| {
                 for (s, &q) in o.iter_mut().zip(idx) {
-                    *s = row_sum(table, t.row(q as usize), k);
+                    *s = f64::from(row_sum(table, t.row(q as usize), k));
                 }
             });
     }
@@ -508,26 +509,6 @@ impl Pruning {
         let area: f64 = out.iter().map(|&v| areas[v as usize]).sum();
         area >= alpha && out.len() < self.list.len()
     }
-}
-
-/// `Σ_f table[f K + row[f]]`, summed in four interleaved partial sums (features `f ≡ 0, 1, 2,
-/// 3 mod 4`, combined as `(s0 + s1) + (s2 + s3)`): one running sum would make every addition
-/// wait for the previous one, and this gather is the co-segmentation's inner loop.
-#[inline]
-fn row_sum(table: &[f32], row: &[u8], k: usize) -> f64 {
-    let mut acc = [0.0f32; 4];
-    let quads = row.chunks_exact(4);
-    let tail = quads.remainder();
-    for (tf, rf) in table.chunks_exact(4 * k).zip(quads) {
-        for (j, a) in acc.iter_mut().enumerate() {
-            *a += tf[j * k + rf[j] as usize];
-        }
-    }
-    let start = row.len() - tail.len();
-    for (f, &l) in tail.iter().enumerate() {
-        acc[0] += table[(start + f) * k + l as usize];
-    }
-    f64::from((acc[0] + acc[1]) + (acc[2] + acc[3]))
 }
 
 fn check(graph: &ShapeGraph, options: &CosegmentOptions) -> Result<(), GraphError> {

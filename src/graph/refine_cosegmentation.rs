@@ -3,6 +3,7 @@
 
 use super::shape_graph::ShapeGraph;
 use super::{Cosegmentation, GraphError};
+use crate::affinity::kernel::{Block, LANES, row_sum};
 use crate::spectral::HeatSmoother;
 use crate::stable::{RefineOptions, StableError, assign_regions};
 use rayon::prelude::*;
@@ -147,11 +148,6 @@ pub fn refine_cosegmentation(
 /// gather keeps in one vector register. The tables are `f32`, half the memory the gather reads
 /// per (vertex, feature); scores are sums of 300-odd non-negative terms of similar size, far
 /// from `f32`'s limits (the result matched the `f64` version on TOSCA cats and FAUST).
-const LANES: usize = 8;
-
-/// `LANES` regions' values for one (feature, band).
-type Block = [f32; LANES];
-
 /// Per-shape band counts of every region at once, as region blocks laid out
 /// `[(block · N + feature) · K + band]`, so that one pass over a shape's band table scores
 /// `LANES` regions per table read.
@@ -163,36 +159,6 @@ struct RegionCounts {
     counts: Vec<Vec<Block>>,
     /// `sizes[i][r]`: vertices of region `r` on shape `i`.
     sizes: Vec<Vec<usize>>,
-}
-
-/// `Σ_f part[f K + row[f]]` over blocks, in four interleaved partial sums (features
-/// `f ≡ 0, 1, 2, 3 mod 4`, combined as `(s0 + s1) + (s2 + s3)`) so that consecutive additions
-/// do not wait for each other.
-#[inline]
-fn block_row_sum(part: &[Block], row: &[u8], k: usize) -> Block {
-    let mut acc = [[0.0f32; LANES]; 4];
-    let quads = row.chunks_exact(4);
-    let tail = quads.remainder();
-    for (tf, rf) in part.chunks_exact(4 * k).zip(quads) {
-        for (j, a) in acc.iter_mut().enumerate() {
-            let x = &tf[j * k + rf[j] as usize];
-            for l in 0..LANES {
-                a[l] += x[l];
-            }
-        }
-    }
-    let start = row.len() - tail.len();
-    for (f, &b) in tail.iter().enumerate() {
-        let x = &part[(start + f) * k + b as usize];
-        for l in 0..LANES {
-            acc[0][l] += x[l];
-        }
-    }
-    let mut out = [0.0f32; LANES];
-    for (l, o) in out.iter_mut().enumerate() {
-        *o = (acc[0][l] + acc[1][l]) + (acc[2][l] + acc[3][l]);
-    }
-    out
 }
 
 impl RegionCounts {
@@ -303,7 +269,7 @@ impl RegionCounts {
                 for (o, q) in out.chunks_exact_mut(blocks).zip(chunk * 512..) {
                     let row = t.row(q);
                     for (block, acc) in o.iter_mut().enumerate() {
-                        *acc = block_row_sum(&table[block * nf_i * k..][..nf_i * k], row, k);
+                        *acc = row_sum(&table[block * nf_i * k..][..nf_i * k], row, k);
                     }
                 }
             });
