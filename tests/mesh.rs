@@ -812,11 +812,8 @@ fn off_header_counts(path: &Path) -> (usize, usize) {
 }
 
 fn shared_meshes() -> Vec<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data");
-    let root = if root.exists() {
-        root
-    } else {
-        PathBuf::from("/work/shared/data")
+    let Some(root) = common::shared_data("shared_meshes") else {
+        return Vec::new();
     };
     let mut out = Vec::new();
     for sub in ["tosca", "tosca_hires", "faust", "coseg_chairs/shapes"] {

@@ -356,11 +356,10 @@ fn bad_requests_are_typed_errors() {
 /// evaluation data is absent.
 #[test]
 fn coseg_chairs_if_data_present() {
-    let dir = std::path::Path::new("/work/shared/data/coseg_chairs/shapes");
-    if !dir.exists() {
-        eprintln!("skipping: {} absent", dir.display());
+    let Some(root) = common::shared_data("coseg_chairs_if_data_present") else {
         return;
-    }
+    };
+    let dir = root.join("coseg_chairs/shapes");
     let mut checked = 0;
     for name in ["0.off", "1.off", "101.off"] {
         let Ok(mesh) = coseg::mesh::read_mesh(dir.join(name)) else {

@@ -8,3 +8,16 @@ pub mod graph;
 pub mod mesh;
 pub mod shapes;
 pub mod stable;
+
+/// The evaluation data folder (`../shared/data`: TOSCA, FAUST, COSEG chairs) from the
+/// environment variable `COSEG_DATA`, or `None` after saying that `test` is skipped: no test CI
+/// needs depends on it.
+pub fn shared_data(test: &str) -> Option<std::path::PathBuf> {
+    match std::env::var_os("COSEG_DATA") {
+        Some(dir) if std::path::Path::new(&dir).is_dir() => Some(dir.into()),
+        _ => {
+            eprintln!("{test}: skipped (set COSEG_DATA to the evaluation data folder to run it)");
+            None
+        }
+    }
+}
