@@ -39,31 +39,26 @@ impl Bin for u32 {
     }
 }
 
-impl Bin for f64 {
-    type Acc = f64;
-    const ZERO: f64 = 0.0;
-    #[inline(always)]
-    fn add(acc: f64, x: f64) -> f64 {
-        acc + x
-    }
-    #[inline(always)]
-    fn combine(a: [f64; 4]) -> f64 {
-        (a[0] + a[1]) + (a[2] + a[3])
-    }
+/// Floating-point entries sum in their own type.
+macro_rules! float_bin {
+    ($t:ty) => {
+        impl Bin for $t {
+            type Acc = $t;
+            const ZERO: $t = 0.0;
+            #[inline(always)]
+            fn add(acc: $t, x: $t) -> $t {
+                acc + x
+            }
+            #[inline(always)]
+            fn combine(a: [$t; 4]) -> $t {
+                (a[0] + a[1]) + (a[2] + a[3])
+            }
+        }
+    };
 }
 
-impl Bin for f32 {
-    type Acc = f32;
-    const ZERO: f32 = 0.0;
-    #[inline(always)]
-    fn add(acc: f32, x: f32) -> f32 {
-        acc + x
-    }
-    #[inline(always)]
-    fn combine(a: [f32; 4]) -> f32 {
-        (a[0] + a[1]) + (a[2] + a[3])
-    }
-}
+float_bin!(f64);
+float_bin!(f32);
 
 impl Bin for Block {
     type Acc = Block;

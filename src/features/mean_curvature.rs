@@ -183,21 +183,7 @@ mod tests {
             vec![[0, 1, 4], [1, 2, 4], [2, 3, 4], [3, 0, 4]],
         )
         .unwrap();
-        let lx = cotan_laplacian_times_positions(&mesh);
-        let l = cotan_laplacian(&mesh);
-        for (j, got) in lx.iter().enumerate() {
-            let rows = l.as_ref().row_idx_of_col_raw(j);
-            let vals = l.as_ref().val_of_col(j);
-            let mut want = [0.0; 3];
-            for (&i, &w) in rows.iter().zip(vals) {
-                for (c, out) in want.iter_mut().enumerate() {
-                    *out += w * mesh.positions()[i][c];
-                }
-            }
-            for c in 0..3 {
-                assert!((got[c] - want[c]).abs() < 1e-12, "{j} {c}");
-            }
-        }
+        assert_face_loop_matches_sparse(&mesh);
         let total: f64 = mixed_voronoi_areas(&mesh).iter().sum();
         assert!((total - mesh.total_area()).abs() < 1e-12);
     }
