@@ -628,6 +628,10 @@ fn search_threshold(
 /// extraction stopped, and the merge tree; [`AdaptiveCosegmentation::cut`] gives any coarser
 /// number of parts.
 ///
+/// (About 110 lines: the extraction loop is one sequence of named steps, each a helper —
+/// `search_threshold`, `area_matched`, `confidence`, `acceptance`; splitting it further would
+/// scatter the stop bookkeeping it shares.)
+///
 /// ```
 /// use coseg::bands::equal_count_bands;
 /// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, ShapeGraph, ShapeNode};
