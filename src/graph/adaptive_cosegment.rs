@@ -54,11 +54,11 @@
 //! tree is deterministic.
 
 use super::cosegment::{
-    Engine, area, confidence, sample_triangles, seed_region, spanning_tree, tuple_hash,
+    Engine, TriangleOps, area, confidence, sample_triangles, seed_region, spanning_tree,
+    triangle_ops, tuple_hash,
 };
 use super::shape_graph::ShapeGraph;
 use super::{Cosegmentation, GraphError, RegionTuple};
-use crate::affinity::{BandAffinity, Direction};
 use crate::stable::{Threshold, ThresholdScratch, threshold};
 use crate::vertex_sets::remove_sorted;
 use serde::{Deserialize, Serialize};
@@ -628,6 +628,10 @@ fn search_threshold(
 /// extraction stopped, and the merge tree; [`AdaptiveCosegmentation::cut`] gives any coarser
 /// number of parts.
 ///
+/// (About 110 lines: the extraction loop is one sequence of named steps, each a helper —
+/// `search_threshold`, `area_matched`, `confidence`, `acceptance`; splitting it further would
+/// scatter the stop bookkeeping it shares.)
+///
 /// ```
 /// use coseg::bands::equal_count_bands;
 /// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, ShapeGraph, ShapeNode};
@@ -700,18 +704,7 @@ pub fn adaptive_cosegment(
                 .collect::<Vec<_>>(),
         );
         if enforce {
-            let a = median(&fractions);
-            if conf < o.min_confidence {
-                stop = StopReason::LowConfidence { confidence: conf };
-            } else if let Some(c) = cyc.filter(|&c| c < o.min_cycle_consistency) {
-                stop = StopReason::LowCycleConsistency {
-                    cycle_consistency: c,
-                };
-            } else if separation < o.min_separation {
-                stop = StopReason::NotSeparated { separation };
-            } else if a < o.min_area {
-                stop = StopReason::TooSmall { area: a };
-            }
+            stop = acceptance(o, conf, cyc, separation, &fractions);
             if stop != StopReason::MaxParts {
                 break;
             }
@@ -738,41 +731,11 @@ pub fn adaptive_cosegment(
         });
     }
     if rem.iter().any(|r| !r.is_empty()) || tuples.is_empty() {
-        let tuple = rem.clone();
-        sw.load(&tuple);
-        let (conf, cyc) = confidence(
-            graph,
-            &mut sw.eng,
-            &parent,
-            &tri_ops,
-            &triangles,
-            &rem,
-            &tuple,
-        );
-        tuples.push(RegionTuple {
-            area_fractions: (0..n)
-                .map(|i| area(&graph.node(i).areas, &tuple[i]))
-                .collect(),
-            regions: tuple,
-            sweeps: 0,
-            converged: true,
-            cycled: false,
-            objective: 0.0,
-            confidence: conf,
-            cycle_consistency: cyc,
-            leftover: true,
-        });
+        tuples.push(leftover_tuple(
+            graph, &mut sw, &parent, &tri_ops, &triangles, &rem,
+        ));
     }
-    let alpha = if auto.is_empty() {
-        1.0
-    } else {
-        tuples
-            .iter()
-            .filter(|t| !t.leftover)
-            .map(|t| t.area_fractions.iter().sum::<f64>() / n as f64)
-            .sum::<f64>()
-            / auto.len() as f64
-    };
+    let alpha = mean_alpha(&tuples, auto.len(), n);
     let leaves = Cosegmentation {
         names: (0..n).map(|i| graph.node(i).name.clone()).collect(),
         vertices: (0..n).map(|i| graph.node(i).bands.vertices).collect(),
@@ -789,6 +752,77 @@ pub fn adaptive_cosegment(
         stop,
         tree,
     })
+}
+
+/// The leftover tuple: every shape's remaining vertices, with its confidence and cycle
+/// consistency (loads it into the sweeper's engine).
+fn leftover_tuple(
+    graph: &ShapeGraph,
+    sw: &mut Sweeper<'_>,
+    parent: &[Option<usize>],
+    tri_ops: &[Vec<(
+        crate::affinity::BandAffinity<'_>,
+        crate::affinity::Direction,
+    )>],
+    triangles: &[[usize; 3]],
+    rem: &[Vec<u32>],
+) -> RegionTuple {
+    let tuple = rem.to_vec();
+    sw.load(&tuple);
+    let (conf, cyc) = confidence(graph, &mut sw.eng, parent, tri_ops, triangles, rem, &tuple);
+    RegionTuple {
+        area_fractions: (0..rem.len())
+            .map(|i| area(&graph.node(i).areas, &tuple[i]))
+            .collect(),
+        regions: tuple,
+        sweeps: 0,
+        converged: true,
+        cycled: false,
+        objective: 0.0,
+        confidence: conf,
+        cycle_consistency: cyc,
+        leftover: true,
+    }
+}
+
+/// The mean over the `parts` extracted (non-leftover) tuples of their mean area fraction over
+/// the `n` shapes; 1 when none was extracted.
+fn mean_alpha(tuples: &[RegionTuple], parts: usize, n: usize) -> f64 {
+    if parts == 0 {
+        1.0
+    } else {
+        tuples
+            .iter()
+            .filter(|t| !t.leftover)
+            .map(|t| t.area_fractions.iter().sum::<f64>() / n as f64)
+            .sum::<f64>()
+            / parts as f64
+    }
+}
+
+/// Why a tuple fails the acceptance tests (confidence, cycle consistency, separation, median
+/// area, checked in this order), or [`StopReason::MaxParts`] when it passes them all.
+fn acceptance(
+    o: &AdaptiveOptions,
+    conf: f64,
+    cyc: Option<f64>,
+    separation: f64,
+    fractions: &[f64],
+) -> StopReason {
+    let a = median(fractions);
+    if conf < o.min_confidence {
+        StopReason::LowConfidence { confidence: conf }
+    } else if let Some(c) = cyc.filter(|&c| c < o.min_cycle_consistency) {
+        StopReason::LowCycleConsistency {
+            cycle_consistency: c,
+        }
+    } else if separation < o.min_separation {
+        StopReason::NotSeparated { separation }
+    } else if a < o.min_area {
+        StopReason::TooSmall { area: a }
+    } else {
+        StopReason::MaxParts
+    }
 }
 
 /// Clamps sizes into `[ᾱ / (1 + τ), ᾱ (1 + τ)]` around their median `ᾱ`.
@@ -902,27 +936,6 @@ fn otsu_size(sw: &mut Sweeper<'_>, i: usize, rem: &[u32]) -> f64 {
         }
     }
     best_area
-}
-
-type TriangleOps<'g> = Vec<Vec<(BandAffinity<'g>, Direction)>>;
-
-fn triangle_ops<'g>(
-    graph: &'g ShapeGraph,
-    triangles: &[[usize; 3]],
-) -> Result<TriangleOps<'g>, GraphError> {
-    let mut out = Vec::with_capacity(triangles.len());
-    for t in triangles {
-        let mut ops = Vec::with_capacity(3);
-        for s in 0..3 {
-            let (a, b) = (t[s], t[(s + 1) % 3]);
-            let op = graph
-                .affinity(a, b)
-                .ok_or_else(|| GraphError::BadOption("triangle edge missing".into()))??;
-            ops.push(op);
-        }
-        out.push(ops);
-    }
-    Ok(out)
 }
 
 /// For part `u` transported from the neighbours onto every shape: `sums[i][leaf]` = the

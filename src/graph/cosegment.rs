@@ -745,98 +745,34 @@ pub fn cosegment(
         .collect();
     // Operators of the sampled triangles, built once.
     let triangles = sample_triangles(graph, options.triangles);
-    let mut tri_ops = Vec::with_capacity(triangles.len());
-    for t in &triangles {
-        let mut ops = Vec::with_capacity(3);
-        for s in 0..3 {
-            let (a, b) = (t[s], t[(s + 1) % 3]);
-            let op = graph
-                .affinity(a, b)
-                .ok_or_else(|| GraphError::BadOption("triangle edge missing".into()))??;
-            ops.push(op);
-        }
-        tri_ops.push(ops);
-    }
+    let tri_ops = triangle_ops(graph, &triangles)?;
     let mut tuples = Vec::with_capacity(options.regions);
-    let mut scores = Vec::new();
-    let mut f = Vec::new();
+    let mut scratch = Scratch::default();
     for r in 0..options.regions.saturating_sub(1) {
         if rem.iter().any(Vec::is_empty) {
             break;
         }
-        let mut tuple: Vec<Vec<u32>> = vec![Vec::new(); n];
-        for i in 0..n {
-            eng.set_region(i, &[]);
-        }
-        tuple[root] = seed_region(graph, root, &rem[root], options.seed, r);
-        eng.set_region(root, &tuple[root]);
-        for &c in &order[1..] {
-            let p = parent[c].expect("non-root has a parent");
-            eng.scores(c, Some(&[p]), &rem[c], &mut scores);
-            eng.select(c, &rem[c], &scores, alpha, &mut f);
-            tuple[c].clone_from(&f);
-            eng.set_region(c, &f);
-        }
-        let mut seen = vec![tuple_hash(&tuple)];
-        let mut best: Option<(f64, Vec<Vec<u32>>)> = None;
-        let (mut sweeps, mut converged, mut cycled, mut objective) = (0, false, false, 0.0);
-        // A shape whose neighbours' regions have not changed since its last update would get
-        // the same scores and the same region again: skip it, reusing its objective term.
-        // `changed_at[j]` / `updated_at[i]` are ticks of one clock that advances on every
-        // update, so the skip is exact and the result identical to recomputing everything.
-        let mut clock = 1usize;
-        let mut changed_at = vec![clock; n];
-        let mut updated_at = vec![0usize; n];
-        let mut term = vec![0.0; n];
-        let mut prune = Pruning::new(n);
-        while sweeps < options.max_sweeps {
-            sweeps += 1;
-            let mut changed = false;
-            objective = 0.0;
-            for &i in &order {
-                let stale = eng.neighbours[i]
-                    .iter()
-                    .any(|nb| changed_at[nb.j] >= updated_at[i]);
-                if stale {
-                    clock += 1;
-                    updated_at[i] = clock;
-                    eng.mix(i, None);
-                    if !prune.select(&mut eng, i, &rem[i], alpha, &mut f) {
-                        eng.gather(i, &rem[i], &mut scores);
-                        eng.select(i, &rem[i], &scores, alpha, &mut f);
-                        prune.reset(&eng, i, &rem[i], &scores, &f, alpha);
-                    }
-                    if f != tuple[i] {
-                        changed = true;
-                        changed_at[i] = clock;
-                        tuple[i].clone_from(&f);
-                        eng.set_region(i, &f);
-                    }
-                    term[i] = eng.region_objective(i);
-                }
-                objective += term[i];
-            }
-            if !changed {
-                converged = true;
-                break;
-            }
-            if best.as_ref().is_none_or(|b| objective > b.0) {
-                best = Some((objective, tuple.clone()));
-            }
-            let h = tuple_hash(&tuple);
-            if seen.contains(&h) {
-                cycled = true;
-                break;
-            }
-            seen.push(h);
-        }
-        if !converged && let Some((o, t)) = best {
-            objective = o;
-            tuple = t;
-            for (i, region) in tuple.iter().enumerate() {
-                eng.set_region(i, region);
-            }
-        }
+        let seed = seed_region(graph, root, &rem[root], options.seed, r);
+        let tree = Tree {
+            root,
+            order: &order,
+            parent: &parent,
+        };
+        let mut tuple = grow_tuple(&mut eng, &tree, seed, &rem, alpha, &mut scratch);
+        let SweepOutcome {
+            sweeps,
+            converged,
+            cycled,
+            objective,
+        } = sweep_tuple(
+            &mut eng,
+            &order,
+            &rem,
+            &mut tuple,
+            alpha,
+            options.max_sweeps,
+            &mut scratch,
+        );
         let (confidence, cyc) =
             confidence(graph, &mut eng, &parent, &tri_ops, &triangles, &rem, &tuple);
         for (i, region) in tuple.iter().enumerate() {
@@ -891,6 +827,160 @@ pub fn cosegment(
         alpha,
         tuples,
     })
+}
+
+/// The spanning tree a tuple grows along: its root, the visiting order (root first) and each
+/// shape's parent.
+struct Tree<'a> {
+    root: usize,
+    order: &'a [usize],
+    parent: &'a [Option<usize>],
+}
+
+/// Buffers reused across shapes and tuples: the scores of the candidate vertices and the
+/// selected region.
+#[derive(Default)]
+struct Scratch {
+    scores: Vec<f64>,
+    f: Vec<u32>,
+}
+
+/// How the block-coordinate sweeps of one tuple ended.
+struct SweepOutcome {
+    sweeps: usize,
+    converged: bool,
+    cycled: bool,
+    objective: f64,
+}
+
+/// The band-affinity operators of the three edges of each sampled triangle, per triangle.
+pub(super) type TriangleOps<'g> = Vec<Vec<(BandAffinity<'g>, crate::affinity::Direction)>>;
+
+/// The band-affinity operators of the three edges of each sampled triangle.
+pub(super) fn triangle_ops<'g>(
+    graph: &'g ShapeGraph,
+    triangles: &[[usize; 3]],
+) -> Result<TriangleOps<'g>, GraphError> {
+    let mut tri_ops = Vec::with_capacity(triangles.len());
+    for t in triangles {
+        let mut ops = Vec::with_capacity(3);
+        for s in 0..3 {
+            let (a, b) = (t[s], t[(s + 1) % 3]);
+            let op = graph
+                .affinity(a, b)
+                .ok_or_else(|| GraphError::BadOption("triangle edge missing".into()))??;
+            ops.push(op);
+        }
+        tri_ops.push(ops);
+    }
+    Ok(tri_ops)
+}
+
+/// The initial tuple: the root's `seed` region, then each other shape's region selected from
+/// its parent's alone, in tree order (the engine's histograms end holding the tuple).
+fn grow_tuple(
+    eng: &mut Engine<'_>,
+    tree: &Tree<'_>,
+    seed: Vec<u32>,
+    rem: &[Vec<u32>],
+    alpha: f64,
+    scratch: &mut Scratch,
+) -> Vec<Vec<u32>> {
+    let mut tuple: Vec<Vec<u32>> = vec![Vec::new(); rem.len()];
+    for i in 0..rem.len() {
+        eng.set_region(i, &[]);
+    }
+    tuple[tree.root] = seed;
+    eng.set_region(tree.root, &tuple[tree.root]);
+    for &c in &tree.order[1..] {
+        let p = tree.parent[c].expect("non-root has a parent");
+        eng.scores(c, Some(&[p]), &rem[c], &mut scratch.scores);
+        eng.select(c, &rem[c], &scratch.scores, alpha, &mut scratch.f);
+        tuple[c].clone_from(&scratch.f);
+        eng.set_region(c, &scratch.f);
+    }
+    tuple
+}
+
+/// Block-coordinate sweeps over all shapes in tree order until no region changes, a tuple
+/// repeats or `max_sweeps` is reached; without convergence the best tuple seen is restored
+/// (into `tuple` and the engine).
+fn sweep_tuple(
+    eng: &mut Engine<'_>,
+    order: &[usize],
+    rem: &[Vec<u32>],
+    tuple: &mut Vec<Vec<u32>>,
+    alpha: f64,
+    max_sweeps: usize,
+    scratch: &mut Scratch,
+) -> SweepOutcome {
+    let n = rem.len();
+    let mut seen = vec![tuple_hash(tuple)];
+    let mut best: Option<(f64, Vec<Vec<u32>>)> = None;
+    let (mut sweeps, mut converged, mut cycled, mut objective) = (0, false, false, 0.0);
+    // A shape whose neighbours' regions have not changed since its last update would get
+    // the same scores and the same region again: skip it, reusing its objective term.
+    // `changed_at[j]` / `updated_at[i]` are ticks of one clock that advances on every
+    // update, so the skip is exact and the result identical to recomputing everything.
+    let mut clock = 1usize;
+    let mut changed_at = vec![clock; n];
+    let mut updated_at = vec![0usize; n];
+    let mut term = vec![0.0; n];
+    let mut prune = Pruning::new(n);
+    while sweeps < max_sweeps {
+        sweeps += 1;
+        let mut changed = false;
+        objective = 0.0;
+        for &i in order {
+            let stale = eng.neighbours[i]
+                .iter()
+                .any(|nb| changed_at[nb.j] >= updated_at[i]);
+            if stale {
+                clock += 1;
+                updated_at[i] = clock;
+                eng.mix(i, None);
+                if !prune.select(eng, i, &rem[i], alpha, &mut scratch.f) {
+                    eng.gather(i, &rem[i], &mut scratch.scores);
+                    eng.select(i, &rem[i], &scratch.scores, alpha, &mut scratch.f);
+                    prune.reset(eng, i, &rem[i], &scratch.scores, &scratch.f, alpha);
+                }
+                if scratch.f != tuple[i] {
+                    changed = true;
+                    changed_at[i] = clock;
+                    tuple[i].clone_from(&scratch.f);
+                    eng.set_region(i, &scratch.f);
+                }
+                term[i] = eng.region_objective(i);
+            }
+            objective += term[i];
+        }
+        if !changed {
+            converged = true;
+            break;
+        }
+        if best.as_ref().is_none_or(|b| objective > b.0) {
+            best = Some((objective, tuple.clone()));
+        }
+        let h = tuple_hash(tuple);
+        if seen.contains(&h) {
+            cycled = true;
+            break;
+        }
+        seen.push(h);
+    }
+    if !converged && let Some((o, t)) = best {
+        objective = o;
+        *tuple = t;
+        for (i, region) in tuple.iter().enumerate() {
+            eng.set_region(i, region);
+        }
+    }
+    SweepOutcome {
+        sweeps,
+        converged,
+        cycled,
+        objective,
+    }
 }
 
 /// Tree-edge agreement and triangle cycle consistency of a tuple (the engine's histograms hold

@@ -201,45 +201,7 @@ impl ShapeGraph {
     /// assert_eq!(g.edge_count(), 3);
     /// ```
     pub fn build(nodes: Vec<ShapeNode>, options: &GraphOptions) -> Result<Self, GraphError> {
-        if let Some(first) = nodes.first() {
-            for node in &nodes {
-                if node.bands.bands != first.bands.bands
-                    || node.bands.features != first.bands.features
-                {
-                    return Err(GraphError::Incompatible {
-                        name: node.name.clone(),
-                        reason: format!(
-                            "K = {}, N = {} but {} has K = {}, N = {}",
-                            node.bands.bands,
-                            node.bands.features,
-                            first.name,
-                            first.bands.bands,
-                            first.bands.features
-                        ),
-                    });
-                }
-                if node.areas.len() != node.bands.vertices {
-                    return Err(GraphError::Incompatible {
-                        name: node.name.clone(),
-                        reason: "area vector does not match the vertex count".into(),
-                    });
-                }
-                // Every stage indexes per-band tables by these labels; the graph owns its nodes
-                // immutably, so one check here covers them all.
-                let t = &node.bands;
-                if t.labels.len() != t.vertices * t.features
-                    || t.labels.iter().any(|&l| l as usize >= t.bands)
-                {
-                    return Err(GraphError::Incompatible {
-                        name: node.name.clone(),
-                        reason: format!(
-                            "band table is not {} × {} labels below K = {}",
-                            t.vertices, t.features, t.bands
-                        ),
-                    });
-                }
-            }
-        }
+        check_nodes(&nodes)?;
         let n = nodes.len();
         let features = nodes.first().map_or(0, |f| f.bands.features);
         let summaries: Vec<Vec<f64>> = {
@@ -259,45 +221,8 @@ impl ShapeGraph {
             )
         } else {
             let k = options.neighbours.max(1);
-            let mut set = BTreeSet::new();
-            for i in 0..n {
-                let mut others: Vec<(f64, usize)> = (0..n)
-                    .filter(|&j| j != i)
-                    .map(|j| (dist(i, j), j))
-                    .collect();
-                others.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-                for &(_, j) in others.iter().take(k) {
-                    set.insert((i.min(j), i.max(j)));
-                }
-            }
-            // Prim's minimum spanning tree on the complete distance graph.
-            let mut in_tree = vec![false; n];
-            let mut best = vec![(f64::INFINITY, usize::MAX); n];
-            in_tree[0] = true;
-            for (j, b) in best.iter_mut().enumerate().skip(1) {
-                *b = (dist(0, j), 0);
-            }
-            for _ in 1..n {
-                let mut pick = usize::MAX;
-                for j in 0..n {
-                    if !in_tree[j]
-                        && (pick == usize::MAX || best[j].0.total_cmp(&best[pick].0).is_lt())
-                    {
-                        pick = j;
-                    }
-                }
-                in_tree[pick] = true;
-                let p = best[pick].1;
-                set.insert((p.min(pick), p.max(pick)));
-                for j in 0..n {
-                    if !in_tree[j] {
-                        let d = dist(pick, j);
-                        if d.total_cmp(&best[j].0).is_lt() {
-                            best[j] = (d, pick);
-                        }
-                    }
-                }
-            }
+            let mut set = nearest_pairs(n, k, &dist);
+            add_spanning_tree(n, &dist, &mut set);
             (GraphKind::Nearest(k), set)
         };
         let mut ds: Vec<f64> = pairs.iter().map(|&(i, j)| dist(i, j)).collect();
@@ -437,5 +362,106 @@ impl ShapeGraph {
                 .map(|w| (w, dir))
                 .map_err(GraphError::from),
         )
+    }
+}
+
+/// Rejects nodes whose band tables disagree with the first node's `K` and `N`, whose area
+/// vector does not match the vertex count, or whose labels are not `vertices × features`
+/// values below `K`.
+fn check_nodes(nodes: &[ShapeNode]) -> Result<(), GraphError> {
+    if let Some(first) = nodes.first() {
+        for node in nodes {
+            if node.bands.bands != first.bands.bands || node.bands.features != first.bands.features
+            {
+                return Err(GraphError::Incompatible {
+                    name: node.name.clone(),
+                    reason: format!(
+                        "K = {}, N = {} but {} has K = {}, N = {}",
+                        node.bands.bands,
+                        node.bands.features,
+                        first.name,
+                        first.bands.bands,
+                        first.bands.features
+                    ),
+                });
+            }
+            if node.areas.len() != node.bands.vertices {
+                return Err(GraphError::Incompatible {
+                    name: node.name.clone(),
+                    reason: "area vector does not match the vertex count".into(),
+                });
+            }
+            // Every stage indexes per-band tables by these labels; the graph owns its nodes
+            // immutably, so one check here covers them all.
+            let t = &node.bands;
+            if t.labels.len() != t.vertices * t.features
+                || t.labels.iter().any(|&l| l as usize >= t.bands)
+            {
+                return Err(GraphError::Incompatible {
+                    name: node.name.clone(),
+                    reason: format!(
+                        "band table is not {} × {} labels below K = {}",
+                        t.vertices, t.features, t.bands
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The edges linking each of the `n` shapes to its `k` nearest by `dist` (ties by index), as
+/// `(min, max)` pairs.
+fn nearest_pairs(
+    n: usize,
+    k: usize,
+    dist: &impl Fn(usize, usize) -> f64,
+) -> BTreeSet<(usize, usize)> {
+    let mut set = BTreeSet::new();
+    for i in 0..n {
+        let mut others: Vec<(f64, usize)> = (0..n)
+            .filter(|&j| j != i)
+            .map(|j| (dist(i, j), j))
+            .collect();
+        others.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for &(_, j) in others.iter().take(k) {
+            set.insert((i.min(j), i.max(j)));
+        }
+    }
+    set
+}
+
+/// Adds to `set` the edges of the minimum spanning tree of the complete `dist` graph on `n`
+/// shapes (Prim from node 0, ties by index).
+fn add_spanning_tree(
+    n: usize,
+    dist: &impl Fn(usize, usize) -> f64,
+    set: &mut BTreeSet<(usize, usize)>,
+) {
+    // Prim's minimum spanning tree on the complete distance graph.
+    let mut in_tree = vec![false; n];
+    let mut best = vec![(f64::INFINITY, usize::MAX); n];
+    in_tree[0] = true;
+    for (j, b) in best.iter_mut().enumerate().skip(1) {
+        *b = (dist(0, j), 0);
+    }
+    for _ in 1..n {
+        let mut pick = usize::MAX;
+        for j in 0..n {
+            if !in_tree[j] && (pick == usize::MAX || best[j].0.total_cmp(&best[pick].0).is_lt()) {
+                pick = j;
+            }
+        }
+        in_tree[pick] = true;
+        let p = best[pick].1;
+        set.insert((p.min(pick), p.max(pick)));
+        for j in 0..n {
+            if !in_tree[j] {
+                let d = dist(pick, j);
+                if d.total_cmp(&best[j].0).is_lt() {
+                    best[j] = (d, pick);
+                }
+            }
+        }
     }
 }

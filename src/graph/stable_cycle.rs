@@ -125,52 +125,8 @@ pub fn stable_cycle_with(
     options: &StableCycleOptions,
     ws: &mut AffinityWorkspace,
 ) -> Result<StableCycle, GraphError> {
+    check_cycle(shapes, steps, f0)?;
     let m = shapes.len();
-    if m < 2 {
-        return Err(GraphError::BadOption(format!(
-            "a cycle needs at least 2 shapes, got {m}"
-        )));
-    }
-    if steps.len() != m {
-        return Err(GraphError::BadOption(format!(
-            "{m} shapes need {m} steps, got {}",
-            steps.len()
-        )));
-    }
-    for (i, step) in steps.iter().enumerate() {
-        let (src, dst) = match step.direction {
-            Direction::AtoB => (step.affinity.cols(), step.affinity.rows()),
-            Direction::BtoA => (step.affinity.rows(), step.affinity.cols()),
-        };
-        let (s, d) = (&shapes[i], &shapes[(i + 1) % m]);
-        if s.areas.len() != src || d.areas.len() != dst {
-            return Err(GraphError::BadOption(format!(
-                "step {i} maps {src} to {dst} vertices, but its shapes have {} and {}",
-                s.areas.len(),
-                d.areas.len()
-            )));
-        }
-    }
-    for (i, s) in shapes.iter().enumerate() {
-        if !ascending(s.remaining) {
-            return Err(GraphError::BadOption(format!(
-                "remaining vertices of cycle shape {i} must be strictly ascending"
-            )));
-        }
-        if s.remaining
-            .last()
-            .is_some_and(|&v| v as usize >= s.areas.len())
-        {
-            return Err(GraphError::BadOption(format!(
-                "remaining vertices of cycle shape {i} exceed its vertex count"
-            )));
-        }
-    }
-    if !ascending(f0) {
-        return Err(GraphError::BadOption(
-            "initial indicator must be strictly ascending".into(),
-        ));
-    }
     let mut scores: Vec<Vec<f64>> = shapes
         .iter()
         .map(|s| vec![0.0; s.remaining.len()])
@@ -245,4 +201,61 @@ pub fn stable_cycle_with(
         cycled,
         history,
     })
+}
+
+/// Rejects a cycle of fewer than 2 shapes, a step count other than the shape count, a step
+/// whose operator does not match its two shapes' vertex counts, and unsorted or out-of-range
+/// remaining sets or initial indicator.
+fn check_cycle(
+    shapes: &[CycleShape<'_>],
+    steps: &[CycleStep<'_, '_>],
+    f0: &[u32],
+) -> Result<(), GraphError> {
+    let m = shapes.len();
+    if m < 2 {
+        return Err(GraphError::BadOption(format!(
+            "a cycle needs at least 2 shapes, got {m}"
+        )));
+    }
+    if steps.len() != m {
+        return Err(GraphError::BadOption(format!(
+            "{m} shapes need {m} steps, got {}",
+            steps.len()
+        )));
+    }
+    for (i, step) in steps.iter().enumerate() {
+        let (src, dst) = match step.direction {
+            Direction::AtoB => (step.affinity.cols(), step.affinity.rows()),
+            Direction::BtoA => (step.affinity.rows(), step.affinity.cols()),
+        };
+        let (s, d) = (&shapes[i], &shapes[(i + 1) % m]);
+        if s.areas.len() != src || d.areas.len() != dst {
+            return Err(GraphError::BadOption(format!(
+                "step {i} maps {src} to {dst} vertices, but its shapes have {} and {}",
+                s.areas.len(),
+                d.areas.len()
+            )));
+        }
+    }
+    for (i, s) in shapes.iter().enumerate() {
+        if !ascending(s.remaining) {
+            return Err(GraphError::BadOption(format!(
+                "remaining vertices of cycle shape {i} must be strictly ascending"
+            )));
+        }
+        if s.remaining
+            .last()
+            .is_some_and(|&v| v as usize >= s.areas.len())
+        {
+            return Err(GraphError::BadOption(format!(
+                "remaining vertices of cycle shape {i} exceed its vertex count"
+            )));
+        }
+    }
+    if !ascending(f0) {
+        return Err(GraphError::BadOption(
+            "initial indicator must be strictly ascending".into(),
+        ));
+    }
+    Ok(())
 }

@@ -60,9 +60,9 @@ pub fn stable_pairs_auto(
                 (!pair.region_a.is_empty() && !pair.region_b.is_empty()).then_some((t, pair)),
             )
         };
-        let mut last = None;
-        match options.t_search {
+        let last = match options.t_search {
             TSearch::Linear => {
+                let mut last = None;
                 for s in 0..=steps {
                     let Some(found) = probe(s, &start, &mut ex)? else {
                         break;
@@ -72,62 +72,17 @@ pub fn stable_pairs_auto(
                     }
                     last = Some(found);
                 }
+                last
             }
-            TSearch::Bisect => {
-                // Bracket the last non-empty step by galloping from the previous pair's step
-                // (up while non-empty, down while empty), then bisect.
-                let s0 = prev_step.min(steps);
-                let (mut lo, mut hi) = (None::<usize>, None::<usize>);
-                let mut keep = |s: usize, found: (f64, StablePair), start: &mut Vec<u32>| {
-                    if options.warm_start {
-                        start.clone_from(&found.1.region_a);
-                    }
-                    last = Some(found);
-                    s
-                };
-                match probe(s0, &start, &mut ex)? {
-                    Some(found) => {
-                        lo = Some(keep(s0, found, &mut start));
-                        let mut d = 1;
-                        while lo != Some(steps) {
-                            let s = (s0 + d).min(steps);
-                            match probe(s, &start, &mut ex)? {
-                                Some(found) => lo = Some(keep(s, found, &mut start)),
-                                None => {
-                                    hi = Some(s);
-                                    break;
-                                }
-                            }
-                            d *= 2;
-                        }
-                    }
-                    None => {
-                        hi = Some(s0);
-                        let mut d = 1;
-                        while hi != Some(0) {
-                            let s = s0.saturating_sub(d);
-                            match probe(s, &start, &mut ex)? {
-                                Some(found) => {
-                                    lo = Some(keep(s, found, &mut start));
-                                    break;
-                                }
-                                None => hi = Some(s),
-                            }
-                            d *= 2;
-                        }
-                    }
-                }
-                if let (Some(mut lo), Some(mut hi)) = (lo, hi) {
-                    while hi - lo > 1 {
-                        let mid = lo + (hi - lo) / 2;
-                        match probe(mid, &start, &mut ex)? {
-                            Some(found) => lo = keep(mid, found, &mut start),
-                            None => hi = mid,
-                        }
-                    }
-                }
-            }
-        }
+            TSearch::Bisect => bisect_search(
+                &mut probe,
+                &mut ex,
+                &mut start,
+                prev_step.min(steps),
+                steps,
+                options.warm_start,
+            )?,
+        };
         let Some((t, pt)) = last else { break };
         prev_step = (t / options.delta_t).round() as usize;
         let alpha =
@@ -157,4 +112,73 @@ pub fn stable_pairs_auto(
         vertices_b: w.rows(),
         pairs,
     })
+}
+
+/// The [`TSearch::Bisect`] search: brackets the last step whose `probe` gives a non-empty pair
+/// by galloping from step `s0` (up while non-empty, down while empty), then bisects. Returns the
+/// last non-empty `(t, pair)` found; with `warm_start`, each found pair's `Ω_A` becomes `start`.
+fn bisect_search<'w, P>(
+    probe: &mut P,
+    ex: &mut Extraction<'w>,
+    start: &mut Vec<u32>,
+    s0: usize,
+    steps: usize,
+    warm_start: bool,
+) -> Result<Option<(f64, StablePair)>, StableError>
+where
+    P: FnMut(usize, &[u32], &mut Extraction<'w>) -> Result<Option<(f64, StablePair)>, StableError>,
+{
+    let mut last = None;
+    // Bracket the last non-empty step by galloping from the previous pair's step
+    // (up while non-empty, down while empty), then bisect.
+    let (mut lo, mut hi) = (None::<usize>, None::<usize>);
+    let mut keep = |s: usize, found: (f64, StablePair), start: &mut Vec<u32>| {
+        if warm_start {
+            start.clone_from(&found.1.region_a);
+        }
+        last = Some(found);
+        s
+    };
+    match probe(s0, start, ex)? {
+        Some(found) => {
+            lo = Some(keep(s0, found, start));
+            let mut d = 1;
+            while lo != Some(steps) {
+                let s = (s0 + d).min(steps);
+                match probe(s, start, ex)? {
+                    Some(found) => lo = Some(keep(s, found, start)),
+                    None => {
+                        hi = Some(s);
+                        break;
+                    }
+                }
+                d *= 2;
+            }
+        }
+        None => {
+            hi = Some(s0);
+            let mut d = 1;
+            while hi != Some(0) {
+                let s = s0.saturating_sub(d);
+                match probe(s, start, ex)? {
+                    Some(found) => {
+                        lo = Some(keep(s, found, start));
+                        break;
+                    }
+                    None => hi = Some(s),
+                }
+                d *= 2;
+            }
+        }
+    }
+    if let (Some(mut lo), Some(mut hi)) = (lo, hi) {
+        while hi - lo > 1 {
+            let mid = lo + (hi - lo) / 2;
+            match probe(mid, start, ex)? {
+                Some(found) => lo = keep(mid, found, start),
+                None => hi = mid,
+            }
+        }
+    }
+    Ok(last)
 }

@@ -69,54 +69,74 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
                 ]);
             }
             "f" | "fo" => {
-                let mut poly = Vec::new();
-                for corner in toks {
-                    let v = corner.split('/').next().unwrap_or("");
-                    let i: i64 = v.parse().map_err(|_| {
-                        parse_error(
-                            Some(line),
-                            format!("invalid face corner `{}`", short(corner)),
-                        )
-                    })?;
-                    let resolved = match i {
-                        0 => {
-                            return Err(parse_error(
-                                Some(line),
-                                "vertex index 0 (OBJ indices start at 1)",
-                            ));
-                        }
-                        i if i < 0 => {
-                            let r = positions.len() as i64 + i;
-                            if r < 0 {
-                                return Err(parse_error(
-                                    Some(line),
-                                    format!(
-                                        "relative vertex index {i} points before the first vertex ({} read so far)",
-                                        positions.len()
-                                    ),
-                                ));
-                            }
-                            r
-                        }
-                        i => i - 1,
-                    };
-                    poly.push(resolved);
-                }
-                if poly.len() < 3 {
-                    return Err(parse_error(
-                        Some(line),
-                        format!("face has {} vertices, at least 3 are needed", poly.len()),
-                    ));
-                }
-                polys.push(poly);
+                polys.push(read_face(toks, line, positions.len())?);
             }
             _ => {}
         }
     }
-    let nv = positions.len();
+    let faces = triangulate(&polys, positions.len())?;
+    Ok(RawMesh {
+        positions,
+        faces,
+        warnings: Vec::new(),
+    })
+}
+
+/// The corners of one `f` line as 0-based indices (`read`: the vertices read so far, which
+/// negative indices are relative to); not yet range-checked, since a face may name a later
+/// vertex.
+fn read_face<'a>(
+    toks: impl Iterator<Item = &'a str>,
+    line: usize,
+    read: usize,
+) -> Result<Vec<i64>, MeshError> {
+    let mut poly = Vec::new();
+    for corner in toks {
+        let v = corner.split('/').next().unwrap_or("");
+        let i: i64 = v.parse().map_err(|_| {
+            parse_error(
+                Some(line),
+                format!("invalid face corner `{}`", short(corner)),
+            )
+        })?;
+        let resolved = match i {
+            0 => {
+                return Err(parse_error(
+                    Some(line),
+                    "vertex index 0 (OBJ indices start at 1)",
+                ));
+            }
+            i if i < 0 => {
+                let r = read as i64 + i;
+                if r < 0 {
+                    return Err(parse_error(
+                        Some(line),
+                        format!(
+                            "relative vertex index {i} points before the first vertex ({} read so far)",
+                            read
+                        ),
+                    ));
+                }
+                r
+            }
+            i => i - 1,
+        };
+        poly.push(resolved);
+    }
+    if poly.len() < 3 {
+        return Err(parse_error(
+            Some(line),
+            format!("face has {} vertices, at least 3 are needed", poly.len()),
+        ));
+    }
+    Ok(poly)
+}
+
+/// Range-checks the faces' indices against the `nv` vertices and fan-triangulates them.
+fn triangulate(polys: &[Vec<i64>], nv: usize) -> Result<Vec<[u32; 3]>, MeshError> {
     let mut faces = Vec::with_capacity(polys.len());
     let mut poly32: Vec<u32> = Vec::new();
-    for poly in &polys {
+    for poly in polys {
         poly32.clear();
         for &i in poly {
             // i >= 0 here.
@@ -127,11 +147,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
         }
         fan(&poly32, &mut faces);
     }
-    Ok(RawMesh {
-        positions,
-        faces,
-        warnings: Vec::new(),
-    })
+    Ok(faces)
 }
 
 /// Writes `mesh` as OBJ (`v` and `f` records, 1-based), coordinates in shortest round-trip

@@ -17,6 +17,29 @@ use std::io::Write;
 /// Parses an OFF file held in memory.
 pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
     let mut lines = TokenLines::new(bytes);
+    let (nv, nf) = read_header(&mut lines)?;
+    let positions = read_vertices(&mut lines, nv, nf, bytes.len())?;
+    let faces = read_faces(&mut lines, nv, nf, bytes.len())?;
+    let mut warnings = Vec::new();
+    // Other readers ignore what follows the declared elements (exporters pad files, or append
+    // edges); the mesh is complete, so this is a warning. Invalid UTF-8 there is ignored too.
+    if let Ok(Some((l, _))) = lines.next_tokens() {
+        warnings.push(MeshWarning::IgnoredData {
+            message: format!(
+                "data from line {l} on, after the {nv} vertices and {nf} faces the header declares"
+            ),
+        });
+    }
+    Ok(RawMesh {
+        positions,
+        faces,
+        warnings,
+    })
+}
+
+/// Reads the header keyword and the counts `V F [E]` (on the header line or the next one);
+/// returns the vertex and face counts.
+fn read_header(lines: &mut TokenLines<'_>) -> Result<(usize, usize), MeshError> {
     let Some((hline, htoks)) = lines.next_tokens()? else {
         return Err(MeshError::Empty {
             path: crate::mesh::IN_MEMORY.to_string(),
@@ -66,8 +89,17 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
     if let Some(ne) = counts.get(2) {
         count(ne, "edge")?;
     }
+    Ok((nv, nf))
+}
 
-    let mut positions = Vec::with_capacity(capacity_hint(nv, bytes.len(), 6));
+/// Reads the `nv` vertex lines (`len`: the file's byte length, for the capacity hint).
+fn read_vertices(
+    lines: &mut TokenLines<'_>,
+    nv: usize,
+    nf: usize,
+    len: usize,
+) -> Result<Vec<[f64; 3]>, MeshError> {
+    let mut positions = Vec::with_capacity(capacity_hint(nv, len, 6));
     for i in 0..nv {
         let Some((l, t)) = lines.next_tokens()? else {
             return Err(truncated(format!(
@@ -87,8 +119,18 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
             coordinate(t[2], l)?,
         ]);
     }
+    Ok(positions)
+}
 
-    let mut faces = Vec::with_capacity(capacity_hint(nf, bytes.len(), 8));
+/// Reads the `nf` face lines, checking indices against `nv` and fan-triangulating polygons
+/// (`len`: the file's byte length, for the capacity hint).
+fn read_faces(
+    lines: &mut TokenLines<'_>,
+    nv: usize,
+    nf: usize,
+    len: usize,
+) -> Result<Vec<[u32; 3]>, MeshError> {
+    let mut faces = Vec::with_capacity(capacity_hint(nf, len, 8));
     let mut poly: Vec<u32> = Vec::new();
     for fi in 0..nf {
         let Some((l, t)) = lines.next_tokens()? else {
@@ -127,21 +169,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
         }
         fan(&poly, &mut faces);
     }
-    let mut warnings = Vec::new();
-    // Other readers ignore what follows the declared elements (exporters pad files, or append
-    // edges); the mesh is complete, so this is a warning. Invalid UTF-8 there is ignored too.
-    if let Ok(Some((l, _))) = lines.next_tokens() {
-        warnings.push(MeshWarning::IgnoredData {
-            message: format!(
-                "data from line {l} on, after the {nv} vertices and {nf} faces the header declares"
-            ),
-        });
-    }
-    Ok(RawMesh {
-        positions,
-        faces,
-        warnings,
-    })
+    Ok(faces)
 }
 
 /// Checks the header keyword: `[ST][C][N]OFF`; `4OFF`/`nOFF` (other dimensions) are unsupported.
