@@ -14,7 +14,7 @@
 
 use coseg::affinity::BandAffinity;
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
-use coseg::maps::{ShapeGeometry, map_preset};
+use coseg::maps::ShapeGeometry;
 use coseg::mesh::read_mesh;
 use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
 use coseg::spectral::HeatSmoother;
@@ -63,13 +63,17 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Last, as `coseg pair` does by default: B's regions re-assigned with a point map read from
     // a functional map fitted to the region pairs (smoothed more lightly than the refinement).
-    // Its options depend on how near-isometric the pair is, which the spectra tell.
-    let choice = map_preset(&data_a.spectrum, &data_b.spectrum)?;
+    // Its options depend on how near-isometric the pair is, which the spectra tell: the
+    // library's default `MapStep::Auto` resolves them.
+    let resolved = SegmentPairOptions::default()
+        .map_step
+        .resolve(&data_a.spectrum, &data_b.spectrum)?;
+    let choice = resolved.preset.expect("the default map step runs");
     println!(
         "map step preset {:?} (eigenvalue discrepancy {:.4})",
         choice.preset, choice.discrepancy
     );
-    let map_step = choice.preset.options();
+    let map_step = resolved.options.expect("the default map step runs");
     let map_smoother_b = HeatSmoother::new(&mesh_b, map_step.smoothing_time)?;
     let mapped = map_guided_refinement(
         &w,
@@ -102,10 +106,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bands: &data_b.bands,
             descriptors: Some(&data_b.descriptors.values),
         },
-        &SegmentPairOptions {
-            map_guided: Some(choice.preset.options()),
-            ..Default::default()
-        },
+        &SegmentPairOptions::default(),
     )?;
     assert_eq!(one_call.regions, mapped);
 

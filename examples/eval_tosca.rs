@@ -21,7 +21,7 @@ use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
 use coseg::maps::MapGuidedOptions;
 use coseg::maps::{FinalMatch, ZoomOutOptions, zoomout};
-use coseg::maps::{MapPreset, ShapeGeometry, map_preset};
+use coseg::maps::{MapPreset, MapStep, ShapeGeometry};
 use coseg::mesh::{TriMesh, read_mesh};
 use coseg::pipeline::{ShapeData, ShapePipelineOptions, load_or_compute};
 use coseg::spectral::HeatSmoother;
@@ -44,7 +44,7 @@ enum Post {
     /// The same with [`MapGuidedOptions::near_isometric`] (`coseg pair --map-preset
     /// near-isometric`).
     RefineMapIsometric,
-    /// The same with the preset [`map_preset`] picks for the pair (`coseg pair`'s default).
+    /// The same with the preset `coseg::maps::map_preset` picks for the pair (`coseg pair`'s default).
     RefineMapAuto,
     /// Diagnostic, not a method: [`refine_regions`], then [`point_map_refinement`] with
     /// weight `β` and a ZoomOut map started from the ground truth (what the map step would
@@ -363,7 +363,7 @@ fn main() -> anyhow::Result<()> {
                         }
                         let options = SegmentPairOptions {
                             regions: opts.clone(),
-                            map_guided: Some(map_guided),
+                            map_step: MapStep::Options(map_guided),
                             ..Default::default()
                         };
                         Ok(segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions)
@@ -376,14 +376,18 @@ fn main() -> anyhow::Result<()> {
                             whole_stage(MapGuidedOptions::near_isometric())?
                         }
                         Post::RefineMapAuto => {
-                            let choice = map_preset(&sa.data.spectrum, &sb.data.spectrum)?;
+                            // The library's default map step, resolved here so that
+                            // `--nearest` can change it.
+                            let resolved =
+                                MapStep::default().resolve(&sa.data.spectrum, &sb.data.spectrum)?;
+                            let choice = resolved.preset.expect("the default map step runs");
                             if choice.preset != MapPreset::NearIsometric {
                                 println!(
                                     "  {} x {}: general preset (discrepancy {:.4})",
                                     sa.name, sb.name, choice.discrepancy
                                 );
                             }
-                            whole_stage(choice.preset.options())?
+                            whole_stage(resolved.options.expect("the default map step runs"))?
                         }
                         Post::RefineOracleMap(weight) => {
                             let refined = refined()?;

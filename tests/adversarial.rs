@@ -652,14 +652,12 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
         bands: &data[i].bands,
         descriptors: Some(descriptors[i]),
     };
-    let mut options = SegmentPairOptions::default();
-    options
-        .map_guided
-        .as_mut()
-        .unwrap()
-        .point_map
-        .zoomout
-        .final_size = 40;
+    let mut map_step = coseg::maps::MapGuidedOptions::default();
+    map_step.point_map.zoomout.final_size = 40;
+    let options = SegmentPairOptions {
+        map_step: coseg::maps::MapStep::Options(map_step.clone()),
+        ..Default::default()
+    };
     let out = segment_pair(shape(0), shape(1), &options).unwrap();
     assert_eq!(out.fallbacks.len(), 1, "{:?}", out.fallbacks);
     assert_eq!(out.fallbacks[0].stage, PairStage::MapGuided);
@@ -669,7 +667,7 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
         out.fallbacks[0]
     );
     let without = SegmentPairOptions {
-        map_guided: None,
+        map_step: coseg::maps::MapStep::Off,
         ..options.clone()
     };
     let reference = segment_pair(shape(0), shape(1), &without).unwrap();
@@ -677,8 +675,11 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
     assert_eq!(out.regions.labels_b(), reference.regions.labels_b());
     assert_eq!(out.regions.labels_a(), reference.regions.labels_a());
     // A wrong option is still the caller's error, not a fallback.
-    let mut bad = options;
-    bad.map_guided.as_mut().unwrap().map_weight = f64::NAN;
+    map_step.map_weight = f64::NAN;
+    let bad = SegmentPairOptions {
+        map_step: coseg::maps::MapStep::Options(map_step),
+        ..options
+    };
     assert!(segment_pair(shape(0), shape(1), &bad).is_err());
 }
 

@@ -281,6 +281,52 @@ fn pair_is_deterministic() {
     assert_eq!(assert_same_files(&first.out, &out), 9);
 }
 
+/// The library's default pair call (`segment_pair` with `SegmentPairOptions::default()`, the
+/// shapes through the default per-shape pipeline) is `coseg pair` with no flags: the same
+/// regions on both shapes, and the same map-step preset and discrepancy in the summary (the
+/// `auto` policy is the library's `MapStep::Auto`, not the binary's).
+#[test]
+fn library_default_pair_call_equals_coseg_pair_with_no_flags() {
+    use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
+    use coseg::stable::{PairShape, SegmentPairOptions, segment_pair};
+    let run = pair_run();
+    assert_success(run);
+    let meshes =
+        [PAIR_A, PAIR_B].map(|n| read_mesh(quadrupeds().join(format!("{n}.obj"))).unwrap());
+    let pipe = ShapePipelineOptions::default();
+    let data: Vec<_> = meshes
+        .iter()
+        .map(|m| compute_shape_data(m, &pipe).unwrap())
+        .collect();
+    let shape = |i: usize| PairShape {
+        mesh: &meshes[i],
+        spectrum: &data[i].spectrum,
+        bands: &data[i].bands,
+        descriptors: Some(&data[i].descriptors.values),
+    };
+    let pair = segment_pair(shape(0), shape(1), &SegmentPairOptions::default()).unwrap();
+    assert!(pair.fallbacks.is_empty(), "{:?}", pair.fallbacks);
+    assert_eq!(pair.regions.labels_a(), region_ids(&run.out, PAIR_A));
+    assert_eq!(pair.regions.labels_b(), region_ids(&run.out, PAIR_B));
+    let choice = pair.map_preset.expect("the default map step runs");
+    let json = summary(&run.out);
+    let preset = &json["map_preset"];
+    assert_eq!(
+        preset["discrepancy"].as_f64().unwrap(),
+        choice.discrepancy,
+        "{preset}"
+    );
+    assert_eq!(
+        preset["preset"],
+        serde_json::to_value(choice.preset).unwrap(),
+        "{preset}"
+    );
+    assert_eq!(
+        json["map_guided"],
+        serde_json::to_value(pair.map_guided.as_ref().unwrap()).unwrap()
+    );
+}
+
 #[test]
 fn segment_reports_a_malformed_mesh_and_segments_the_rest() {
     let input = scratch("bad_input");

@@ -795,8 +795,8 @@ fn refine_regions_rebuilds_pairs_with_dense_objectives() {
 mod map_guided {
     use super::common::features::{blob, permutation, permute_mesh};
     use coseg::affinity::{BandAffinity, Direction};
-    use coseg::maps::MapGuidedOptions;
     use coseg::maps::ZoomOutOptions;
+    use coseg::maps::{MapGuidedOptions, MapStep};
     use coseg::maps::{MapShape, PointMapOptions, ShapeGeometry, region_point_map};
     use coseg::mesh::TriMesh;
     use coseg::pipeline::{ShapeData, ShapePipelineOptions, compute_shape_data};
@@ -1083,7 +1083,7 @@ mod map_guided {
                 ..Default::default()
             },
             refine: Some(RefineOptions::default()),
-            map_guided: Some(MapGuidedOptions {
+            map_step: MapStep::Options(MapGuidedOptions {
                 point_map: options(),
                 ..Default::default()
             }),
@@ -1107,7 +1107,8 @@ mod map_guided {
             refine,
         )
         .unwrap();
-        let map_guided = options.map_guided.as_ref().unwrap();
+        let map_guided = out.map_guided.as_ref().unwrap();
+        assert_eq!(out.map_preset, None);
         let by_hand = map_guided_refinement(
             &w,
             &refined,
@@ -1122,7 +1123,7 @@ mod map_guided {
 
         let bare = SegmentPairOptions {
             refine: None,
-            map_guided: None,
+            map_step: MapStep::Off,
             ..options.clone()
         };
         let out = segment_pair(sa, sb, &bare).unwrap();
@@ -1136,7 +1137,7 @@ mod map_guided {
 
 mod preset {
     use super::common::features::{blob, permutation, permute_mesh};
-    use coseg::maps::MapGuidedOptions;
+    use coseg::maps::{MapGuidedOptions, MapStep};
     use coseg::maps::{MapPreset, NEAR_ISOMETRIC_DISCREPANCY, map_preset};
     use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 

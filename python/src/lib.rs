@@ -8,7 +8,6 @@ mod options;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{SegmentCollectionOptions, ShapeNode, load_collection, segment_collection};
 use coseg::labels::{LabelKind, PartNames, read_part_names, read_shape_labels};
-use coseg::maps::PresetChoice;
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
 use coseg::output::{PropagationSummary, write_propagation, 
     CollectionSummary, PairSummary, ShapeRegions, ShapeSummary, SkippedInput, write_regions,
@@ -414,7 +413,7 @@ fn pair<'py>(
                 data.push(d);
             }
             let (da, db) = (&data[0], &data[1]);
-            let (options, choice, chosen) = pair_opts.resolve(&da.spectrum, &db.spectrum)?;
+            let options = pair_opts.options();
             let t = std::time::Instant::now();
             let pair = segment_pair(
                 PairShape {
@@ -447,11 +446,8 @@ fn pair<'py>(
                 seconds,
             )
             .with_refine(options.refine)
-            .with_map_guided(options.map_guided.clone())
-            .with_map_preset(options.map_guided.as_ref().map(|_| PresetChoice {
-                preset: chosen,
-                discrepancy: choice.discrepancy,
-            }))
+            .with_map_guided(pair.map_guided.clone())
+            .with_map_preset(pair.map_preset)
             .with_fallbacks(pair.fallbacks);
             Ok((regions, summary))
         })

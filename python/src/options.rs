@@ -8,12 +8,9 @@ use coseg::features::{
     parse_family_weights,
 };
 use coseg::graph::{CosegmentOptions, GraphOptions, SegmentCollectionOptions};
-use coseg::maps::{
-    MapGuidedOptions, MapPreset, PointMapOptions, PresetChoice, ZoomOutOptions, map_preset,
-};
+use coseg::maps::{MapGuidedOptions, MapOverrides, MapPreset, MapStep, ZoomOutOptions};
 use coseg::pipeline::ShapePipelineOptions;
 use coseg::propagate::PropagateOptions;
-use coseg::spectral::Spectrum;
 use coseg::stable::{
     Algorithm, AreaReference, Init, RefineOptions, SegmentPairOptions, StableRegionsOptions,
     TSearch, Threshold,
@@ -228,12 +225,8 @@ impl<'py> Opts<'py> {
             }),
             preset,
             map_weight: self.take("map_weight")?,
-            map_size: self
-                .take("map_size")?
-                .unwrap_or(ZoomOutOptions::default().final_size),
-            map_smoothing_time: self
-                .take("map_smoothing_time")?
-                .unwrap_or(MapGuidedOptions::default().smoothing_time),
+            map_size: self.take("map_size")?,
+            map_smoothing_time: self.take("map_smoothing_time")?,
         })
     }
 }
@@ -249,39 +242,26 @@ pub struct PairOpts {
     refine: Option<RefineOptions>,
     preset: Option<MapPreset>,
     map_weight: Option<f64>,
-    map_size: usize,
-    map_smoothing_time: f64,
+    map_size: Option<usize>,
+    map_smoothing_time: Option<f64>,
 }
 
 impl PairOpts {
-    /// The full options for the pair with these spectra, the automatic choice and the preset
-    /// used (as `coseg pair` resolves `--map-preset`).
-    pub fn resolve(
-        &self,
-        a: &Spectrum,
-        b: &Spectrum,
-    ) -> Result<(SegmentPairOptions, PresetChoice, MapPreset), coseg::maps::MapError> {
-        let choice = map_preset(a, b)?;
-        let chosen = self.preset.unwrap_or(choice.preset);
-        let preset = chosen.options();
-        let map_weight = self.map_weight.unwrap_or(preset.map_weight);
-        let map_guided = (map_weight > 0.0).then(|| MapGuidedOptions {
-            point_map: PointMapOptions {
-                zoomout: ZoomOutOptions {
-                    final_size: self.map_size,
-                    ..preset.point_map.zoomout.clone()
-                },
-                ..preset.point_map.clone()
-            },
-            map_weight,
+    /// The library's options (the map step resolved by `segment_pair`, as in `coseg pair`).
+    pub fn options(&self) -> SegmentPairOptions {
+        let overrides = MapOverrides {
+            map_weight: self.map_weight,
+            final_size: self.map_size,
             smoothing_time: self.map_smoothing_time,
-        });
-        let options = SegmentPairOptions {
+        };
+        SegmentPairOptions {
             regions: self.regions.clone(),
             refine: self.refine.clone(),
-            map_guided,
-        };
-        Ok((options, choice, chosen))
+            map_step: match self.preset {
+                None => MapStep::Auto(overrides),
+                Some(p) => MapStep::Preset(p, overrides),
+            },
+        }
     }
 }
 

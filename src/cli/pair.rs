@@ -2,16 +2,11 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::maps::MapGuidedOptions;
-use coseg::maps::ZoomOutOptions;
-use coseg::maps::{
-    MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PointMapOptions, PresetChoice, map_preset,
-};
+use coseg::maps::{MapOverrides, MapPreset, MapStep, NEAR_ISOMETRIC_DISCREPANCY};
 use coseg::mesh::TriMesh;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, write_visuals};
 use coseg::pipeline::{PipelineError, ShapeData, ShapePipelineOptions, load_shape};
 use coseg::render::{RenderOptions, RenderShape};
-use coseg::spectral::Spectrum;
 use coseg::stable::{
     Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
     StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
@@ -120,11 +115,13 @@ pub struct PairArgs {
     #[arg(long, conflicts_with = "map_preset")]
     near_isometric: bool,
     /// Size of the last functional map of that step (capped by the eigenpairs computed).
-    #[arg(long, default_value_t = ZoomOutOptions::default().final_size)]
-    map_size: usize,
+    /// [default: the preset's, 60]
+    #[arg(long)]
+    map_size: Option<usize>,
     /// Heat-smoothing time of that step's blended scores (0 = no smoothing).
-    #[arg(long, default_value_t = MapGuidedOptions::default().smoothing_time)]
-    map_smoothing_time: f64,
+    /// [default: the preset's, 0.001]
+    #[arg(long)]
+    map_smoothing_time: Option<f64>,
     /// Ground truth for the correspondence ratio: `identity`, or a file with one B index per
     /// vertex of A (negative = none).
     #[arg(long)]
@@ -204,34 +201,21 @@ fn load_pair(
     Ok(loaded)
 }
 
-/// The map step's options: the preset `--map-preset` (or, with `auto`, the spectra) selects,
-/// with the flags' overrides; the automatic choice and the preset used.
-fn map_step(
-    args: &PairArgs,
-    a: &Spectrum,
-    b: &Spectrum,
-) -> Result<(Option<MapGuidedOptions>, PresetChoice, MapPreset)> {
-    let choice =
-        map_preset(a, b).with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
-    let chosen = match (args.near_isometric, args.map_preset) {
-        (true, _) | (false, MapPresetArg::NearIsometric) => MapPreset::NearIsometric,
-        (false, MapPresetArg::General) => MapPreset::General,
-        (false, MapPresetArg::Auto) => choice.preset,
-    };
-    let preset = chosen.options();
-    let map_weight = args.map_weight.unwrap_or(preset.map_weight);
-    let map_guided = (map_weight > 0.0).then(|| MapGuidedOptions {
-        point_map: PointMapOptions {
-            zoomout: ZoomOutOptions {
-                final_size: args.map_size,
-                ..preset.point_map.zoomout.clone()
-            },
-            ..preset.point_map.clone()
-        },
-        map_weight,
+/// The map step the flags select: `--map-preset` (`auto`: resolved by the library from the
+/// spectra) with the flags' overrides.
+fn map_step(args: &PairArgs) -> MapStep {
+    let overrides = MapOverrides {
+        map_weight: args.map_weight,
+        final_size: args.map_size,
         smoothing_time: args.map_smoothing_time,
-    });
-    Ok((map_guided, choice, chosen))
+    };
+    match (args.near_isometric, args.map_preset) {
+        (true, _) | (false, MapPresetArg::NearIsometric) => {
+            MapStep::Preset(MapPreset::NearIsometric, overrides)
+        }
+        (false, MapPresetArg::General) => MapStep::Preset(MapPreset::General, overrides),
+        (false, MapPresetArg::Auto) => MapStep::Auto(overrides),
+    }
 }
 
 /// preview.png, the two <name>.png and index.html.
@@ -265,11 +249,10 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         max_rounds: args.refine_rounds,
         smoothing_time: args.smoothing_time,
     });
-    let (map_guided, choice, chosen) = map_step(&args, &da.spectrum, &db.spectrum)?;
     let pair_options = SegmentPairOptions {
         regions: options,
         refine,
-        map_guided,
+        map_step: map_step(&args),
     };
     let t = Instant::now();
     let spin = super::spinner("stable regions, refinement and map step");
@@ -332,11 +315,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         seconds,
     )
     .with_refine(pair_options.refine)
-    .with_map_guided(pair_options.map_guided.clone())
-    .with_map_preset(pair_options.map_guided.as_ref().map(|_| PresetChoice {
-        preset: chosen,
-        discrepancy: choice.discrepancy,
-    }))
+    .with_map_guided(pair.map_guided.clone())
+    .with_map_preset(pair.map_preset)
     .with_fallbacks(pair.fallbacks);
     let shapes = [
         ShapeRegions {
@@ -357,10 +337,10 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     if super::quiet() {
         return Ok(ExitCode::SUCCESS);
     }
-    if pair_options.map_guided.is_some() {
+    if let Some(choice) = pair.map_preset {
         println!(
             "map step: {} preset (eigenvalue discrepancy {:.4}; near-isometric below {})",
-            match chosen {
+            match choice.preset {
                 MapPreset::General => "general",
                 MapPreset::NearIsometric => "near-isometric",
             },
@@ -412,10 +392,18 @@ mod tests {
         let refine = RefineOptions::default();
         assert_eq!(w.pair.refine_rounds, refine.max_rounds);
         assert_eq!(w.pair.smoothing_time, refine.smoothing_time);
-        assert_eq!(w.pair.map_size, ZoomOutOptions::default().final_size);
+        assert_eq!(map_step(&w.pair), MapStep::default());
+        // The help's stated defaults are the presets' own.
+        for preset in [MapPreset::General, MapPreset::NearIsometric] {
+            let o = preset.options();
+            assert_eq!(o.point_map.zoomout.final_size, 60);
+            assert_eq!(o.smoothing_time, 0.001);
+        }
+        let near =
+            Wrapper::try_parse_from(["coseg", "a", "b", "-o", "o", "--near-isometric"]).unwrap();
         assert_eq!(
-            w.pair.map_smoothing_time,
-            MapGuidedOptions::default().smoothing_time
+            map_step(&near.pair),
+            MapStep::Preset(MapPreset::NearIsometric, MapOverrides::default())
         );
     }
 }

@@ -124,3 +124,97 @@ pub fn map_preset(a: &Spectrum, b: &Spectrum) -> Result<PresetChoice, MapError> 
         discrepancy,
     })
 }
+
+/// Changes to a preset's options, each `None` keeping the preset's value (`coseg pair`'s
+/// `--map-weight`, `--map-size`, `--map-smoothing-time`).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+pub struct MapOverrides {
+    /// [`MapGuidedOptions::map_weight`]; `0` turns the map step off.
+    pub map_weight: Option<f64>,
+    /// The last functional map's size ([`ZoomOutOptions::final_size`](super::ZoomOutOptions)).
+    pub final_size: Option<usize>,
+    /// [`MapGuidedOptions::smoothing_time`].
+    pub smoothing_time: Option<f64>,
+}
+
+impl MapOverrides {
+    /// The preset's options with these changes; `None` when the weight is not positive (the
+    /// step is off).
+    pub fn apply(&self, preset: MapPreset) -> Option<MapGuidedOptions> {
+        let mut options = preset.options();
+        if let Some(w) = self.map_weight {
+            options.map_weight = w;
+        }
+        if let Some(n) = self.final_size {
+            options.point_map.zoomout.final_size = n;
+        }
+        if let Some(t) = self.smoothing_time {
+            options.smoothing_time = t;
+        }
+        (options.map_weight > 0.0).then_some(options)
+    }
+}
+
+/// How the map step of [`segment_pair`](crate::stable::segment_pair) gets its options.
+///
+/// The default, [`MapStep::Auto`], is what `coseg pair` runs with no flags: the preset
+/// [`map_preset`] picks from the two spectra.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub enum MapStep {
+    /// The preset [`map_preset`] picks from the two spectra, with the overrides (default:
+    /// none).
+    Auto(MapOverrides),
+    /// This preset whatever the spectra, with the overrides.
+    Preset(MapPreset, MapOverrides),
+    /// These options as they are (no preset).
+    Options(MapGuidedOptions),
+    /// No map step.
+    Off,
+}
+
+impl Default for MapStep {
+    fn default() -> Self {
+        MapStep::Auto(MapOverrides::default())
+    }
+}
+
+/// A [`MapStep`] resolved for one pair.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResolvedMapStep {
+    /// The map step's options; `None` when it does not run.
+    pub options: Option<MapGuidedOptions>,
+    /// The preset used and the pair's discrepancy, when the step runs with a preset
+    /// ([`MapStep::Auto`] or [`MapStep::Preset`]); `None` otherwise.
+    pub preset: Option<PresetChoice>,
+}
+
+impl MapStep {
+    /// The options for shapes with spectra `a` and `b`. The discrepancy is computed for
+    /// [`MapStep::Auto`] and [`MapStep::Preset`] (reported with the preset used), and errors
+    /// only there.
+    pub fn resolve(&self, a: &Spectrum, b: &Spectrum) -> Result<ResolvedMapStep, MapError> {
+        let with_preset = |preset: Option<MapPreset>, overrides: &MapOverrides| {
+            let choice = map_preset(a, b)?;
+            let preset = preset.unwrap_or(choice.preset);
+            let options = overrides.apply(preset);
+            let preset = options.as_ref().map(|_| PresetChoice {
+                preset,
+                discrepancy: choice.discrepancy,
+            });
+            Ok(ResolvedMapStep { options, preset })
+        };
+        match self {
+            MapStep::Auto(o) => with_preset(None, o),
+            MapStep::Preset(p, o) => with_preset(Some(*p), o),
+            MapStep::Options(o) => Ok(ResolvedMapStep {
+                options: Some(o.clone()),
+                preset: None,
+            }),
+            MapStep::Off => Ok(ResolvedMapStep {
+                options: None,
+                preset: None,
+            }),
+        }
+    }
+}

@@ -16,8 +16,8 @@ pub(crate) mod zoomout;
 pub use auction_assignment::{Assignment, AuctionOptions, CandidateLists, auction_assignment};
 pub use eigenvalue_discrepancy::eigenvalue_discrepancy;
 pub use map_preset::{
-    MapGuidedOptions, MapPreset, NEAR_ISOMETRIC_DISCREPANCY, PRESET_EIGENVALUES, PresetChoice,
-    map_preset,
+    MapGuidedOptions, MapOverrides, MapPreset, MapStep, NEAR_ISOMETRIC_DISCREPANCY,
+    PRESET_EIGENVALUES, PresetChoice, ResolvedMapStep, map_preset,
 };
 pub use region_point_map::{MapShape, PointMapOptions, region_point_map};
 pub use zoomout::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};

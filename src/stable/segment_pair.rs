@@ -7,16 +7,16 @@ use super::{
 };
 use crate::affinity::BandAffinity;
 use crate::bands::BandTable;
-use crate::maps::MapGuidedOptions;
 use crate::maps::ShapeGeometry;
+use crate::maps::{MapGuidedOptions, MapStep, PresetChoice};
 use crate::mesh::TriMesh;
 use crate::spectral::{HeatSmoother, Spectrum};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
-/// Options of [`segment_pair`]. The defaults suit any pair; `coseg pair` replaces the map
-/// step's options by those [`map_preset`](crate::maps::map_preset) picks from the two spectra
-/// (`MapPreset::options`), which on two poses of one body is the configuration that scores
+/// Options of [`segment_pair`]. The defaults are `coseg pair`'s with no flags: the map step's
+/// options are those [`map_preset`](crate::maps::map_preset) picks from the two spectra
+/// ([`MapStep::Auto`]), which on two poses of one body is the configuration that scores
 /// best on the TOSCA within-class pairs (README, "Correspondence ratio").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SegmentPairOptions {
@@ -26,9 +26,10 @@ pub struct SegmentPairOptions {
     /// Boundary refinement of both partitions; `None` keeps the algorithm's regions
     /// (default: [`RefineOptions::default`]).
     pub refine: Option<RefineOptions>,
-    /// The last step, B's regions re-assigned by band affinity and a point map; `None`
-    /// skips it (default: [`MapGuidedOptions::default`]).
-    pub map_guided: Option<MapGuidedOptions>,
+    /// The last step, B's regions re-assigned by band affinity and a point map: its options,
+    /// resolved for the pair ([`MapStep::resolve`]); [`MapStep::Off`] skips it (default:
+    /// [`MapStep::Auto`]).
+    pub map_step: MapStep,
 }
 
 impl Default for SegmentPairOptions {
@@ -36,7 +37,7 @@ impl Default for SegmentPairOptions {
         SegmentPairOptions {
             regions: StableRegionsOptions::default(),
             refine: Some(RefineOptions::default()),
-            map_guided: Some(MapGuidedOptions::default()),
+            map_step: MapStep::default(),
         }
     }
 }
@@ -89,6 +90,12 @@ pub struct SegmentedPair {
     /// The optional stages that could not run on these shapes (each kept the previous
     /// stage's regions), in stage order; empty when every requested stage ran.
     pub fallbacks: Vec<StageFallback>,
+    /// The map step's options as resolved for this pair ([`MapStep::resolve`]); `None` when
+    /// it was off.
+    pub map_guided: Option<MapGuidedOptions>,
+    /// The preset the map step used and the pair's eigenvalue discrepancy, when it ran with a
+    /// preset.
+    pub map_preset: Option<PresetChoice>,
 }
 
 /// Stable region correspondences between two shapes: Algorithm 2 or 3 ([`stable_regions`]),
@@ -132,7 +139,9 @@ pub fn segment_pair(
             )));
         }
     }
-    check_stage_options(options)?;
+    let resolved = options.map_step.resolve(a.spectrum, b.spectrum)?;
+    let (map_guided_options, map_preset) = (resolved.options, resolved.preset);
+    check_stage_options(options.refine.as_ref(), map_guided_options.as_ref())?;
     let mut times = PairTimes::default();
     let mut fallbacks = Vec::new();
     let (areas_a, areas_b) = (a.mesh.vertex_areas(), b.mesh.vertex_areas());
@@ -140,12 +149,14 @@ pub fn segment_pair(
     let mut regions = stable_regions(a.bands, b.bands, &areas_a, &areas_b, &options.regions)?;
     times.algorithm = t.elapsed();
     let refine = options.refine.as_ref().filter(|r| r.max_rounds > 0);
-    let map_guided = options.map_guided.as_ref();
+    let map_guided = map_guided_options.as_ref();
     if refine.is_none() && map_guided.is_none() {
         return Ok(SegmentedPair {
             regions,
             times,
             fallbacks,
+            map_guided: map_guided_options,
+            map_preset,
         });
     }
     let w = match BandAffinity::new(a.bands, b.bands) {
@@ -164,6 +175,8 @@ pub fn segment_pair(
                 regions,
                 times,
                 fallbacks,
+                map_guided: map_guided_options,
+                map_preset,
             });
         }
     };
@@ -224,12 +237,17 @@ pub fn segment_pair(
         regions,
         times,
         fallbacks,
+        map_guided: map_guided_options,
+        map_preset,
     })
 }
 
 /// The options' own ranges, checked before any stage runs: a wrong option is the caller's
 /// error, not a reason for a stage to fall back.
-fn check_stage_options(options: &SegmentPairOptions) -> Result<(), StableError> {
+fn check_stage_options(
+    refine: Option<&RefineOptions>,
+    map_guided: Option<&MapGuidedOptions>,
+) -> Result<(), StableError> {
     let non_negative = |name: &str, x: f64| {
         if x.is_finite() && x >= 0.0 {
             Ok(())
@@ -239,10 +257,10 @@ fn check_stage_options(options: &SegmentPairOptions) -> Result<(), StableError> 
             )))
         }
     };
-    if let Some(r) = &options.refine {
+    if let Some(r) = refine {
         non_negative("refine smoothing_time", r.smoothing_time)?;
     }
-    if let Some(m) = &options.map_guided {
+    if let Some(m) = map_guided {
         non_negative("map_weight", m.map_weight)?;
         non_negative("map smoothing_time", m.smoothing_time)?;
         let z = &m.point_map.zoomout;
