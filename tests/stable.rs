@@ -1137,7 +1137,7 @@ mod map_guided {
 
 mod preset {
     use super::common::features::{blob, permutation, permute_mesh};
-    use coseg::maps::{MapGuidedOptions, MapStep};
+    use coseg::maps::MapGuidedOptions;
     use coseg::maps::{MapPreset, NEAR_ISOMETRIC_DISCREPANCY, map_preset};
     use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 

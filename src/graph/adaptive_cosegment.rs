@@ -54,8 +54,8 @@
 //! tree is deterministic.
 
 use super::cosegment::{
-    Engine, TriangleOps, area, confidence, sample_triangles, seed_region, spanning_tree,
-    triangle_ops, tuple_hash,
+    Engine, area, confidence, sample_triangles, seed_region, spanning_tree, triangle_ops,
+    tuple_hash,
 };
 use super::shape_graph::ShapeGraph;
 use super::{Cosegmentation, GraphError, RegionTuple};
