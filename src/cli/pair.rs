@@ -115,7 +115,7 @@ pub struct PairArgs {
     #[arg(long, conflicts_with = "map_preset")]
     near_isometric: bool,
     /// Size of the last functional map of that step (capped by the eigenpairs computed).
-    /// [default: the preset's, 60]
+    /// [default: the preset's, 150]
     #[arg(long)]
     map_size: Option<usize>,
     /// Heat-smoothing time of that step's blended scores (0 = no smoothing).
@@ -396,7 +396,7 @@ mod tests {
         // The help's stated defaults are the presets' own.
         for preset in [MapPreset::General, MapPreset::NearIsometric] {
             let o = preset.options();
-            assert_eq!(o.point_map.zoomout.final_size, 60);
+            assert_eq!(o.point_map.zoomout.final_size, 150);
             assert_eq!(o.smoothing_time, 0.001);
         }
         let near =
