@@ -54,8 +54,8 @@
 //! tree is deterministic.
 
 use super::cosegment::{
-    Engine, area, confidence, sample_triangles, seed_region, spanning_tree, triangle_ops,
-    tuple_hash,
+    Engine, area, confidence, leftovers_tuple, sample_triangles, seed_region, spanning_tree,
+    triangle_ops, tuple_hash,
 };
 use super::shape_graph::ShapeGraph;
 use super::{Cosegmentation, GraphError, RegionTuple};
@@ -770,19 +770,7 @@ fn leftover_tuple(
     let tuple = rem.to_vec();
     sw.load(&tuple);
     let (conf, cyc) = confidence(graph, &mut sw.eng, parent, tri_ops, triangles, rem, &tuple);
-    RegionTuple {
-        area_fractions: (0..rem.len())
-            .map(|i| area(&graph.node(i).areas, &tuple[i]))
-            .collect(),
-        regions: tuple,
-        sweeps: 0,
-        converged: true,
-        cycled: false,
-        objective: 0.0,
-        confidence: conf,
-        cycle_consistency: cyc,
-        leftover: true,
-    }
+    leftovers_tuple(graph, tuple, conf, cyc)
 }
 
 /// The mean over the `parts` extracted (non-leftover) tuples of their mean area fraction over

@@ -631,6 +631,30 @@ pub(super) fn seed_region(
     }
 }
 
+/// The last tuple: the leftover vertices of every shape, with their confidences.
+pub(super) fn leftovers_tuple(
+    graph: &ShapeGraph,
+    regions: Vec<Vec<u32>>,
+    confidence: f64,
+    cycle_consistency: Option<f64>,
+) -> RegionTuple {
+    RegionTuple {
+        area_fractions: regions
+            .iter()
+            .enumerate()
+            .map(|(i, t)| area(&graph.node(i).areas, t))
+            .collect(),
+        regions,
+        sweeps: 0,
+        converged: true,
+        cycled: false,
+        objective: 0.0,
+        confidence,
+        cycle_consistency,
+        leftover: true,
+    }
+}
+
 pub(super) fn area(areas: &[f64], v: &[u32]) -> f64 {
     v.iter().map(|&p| areas[p as usize]).sum()
 }
@@ -802,21 +826,7 @@ pub fn cosegment(
         }
         let (confidence, cyc) =
             confidence(graph, &mut eng, &parent, &tri_ops, &triangles, &rem, &tuple);
-        tuples.push(RegionTuple {
-            area_fractions: tuple
-                .iter()
-                .enumerate()
-                .map(|(i, t)| area(&graph.node(i).areas, t))
-                .collect(),
-            regions: tuple,
-            sweeps: 0,
-            converged: true,
-            cycled: false,
-            objective: 0.0,
-            confidence,
-            cycle_consistency: cyc,
-            leftover: true,
-        });
+        tuples.push(leftovers_tuple(graph, tuple, confidence, cyc));
     }
     Ok(Cosegmentation {
         names: (0..n).map(|i| graph.node(i).name.clone()).collect(),
