@@ -97,9 +97,10 @@ fn algorithm_2(c: &mut Criterion) {
 
 fn spectrum_and_map(c: &mut Criterion) {
     let mesh = grid(50);
-    let options = SpectrumOptions {
-        eigenpairs: 40,
-        ..Default::default()
+    let options = {
+        let mut opts = SpectrumOptions::default();
+        opts.eigenpairs = 40;
+        opts
     };
     c.bench_function("spectrum/2500v_k40", |b| {
         b.iter(|| laplace_beltrami_spectrum(black_box(&mesh), &options).expect("solves"))
@@ -111,10 +112,11 @@ fn spectrum_and_map(c: &mut Criterion) {
         descriptors: None,
     };
     let start: Vec<u32> = (0..mesh.vertex_count() as u32).rev().collect();
-    let zo = ZoomOutOptions {
-        final_size: 40,
-        samples: 500,
-        ..Default::default()
+    let zo = {
+        let mut opts = ZoomOutOptions::default();
+        opts.final_size = 40;
+        opts.samples = 500;
+        opts
     };
     c.bench_function("zoomout/2500v_k10to40", |b| {
         b.iter(|| zoomout(shape, shape, black_box(&start), &zo).expect("runs"))

@@ -29,13 +29,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // The spectrum is that of the mesh scaled to unit area, so eigenvalues are comparable
     // across shapes whatever the units of the file.
-    let spectrum = laplace_beltrami_spectrum(
-        &mesh,
-        &SpectrumOptions {
-            eigenpairs: 20,
-            ..SpectrumOptions::default()
-        },
-    )?;
+    let spectrum = laplace_beltrami_spectrum(&mesh, &{
+        let mut opts = SpectrumOptions::default();
+        opts.eigenpairs = 20;
+        opts
+    })?;
     println!("first eigenvalues (unit-area surface):");
     for (i, lambda) in spectrum.eigenvalues.iter().enumerate() {
         println!("  λ{i:<2} = {lambda:.4}");

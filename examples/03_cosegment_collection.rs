@@ -54,9 +54,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // defaults); and, for comparison, the raw tuples.
     let options = SegmentCollectionOptions::default();
     let refined = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?.segmentation;
-    let raw = SegmentCollectionOptions {
-        refine: None,
-        ..options
+    let raw = {
+        let mut opts = options;
+        opts.refine = None;
+        opts
     };
     let seg = segment_collection(loaded.nodes.clone(), &loaded.meshes, &raw)?.segmentation;
 

@@ -199,9 +199,10 @@ fn main() -> anyhow::Result<()> {
         t2,
         it2
     );
-    let opts3 = StableRegionsOptions {
-        algorithm: Algorithm::Auto,
-        ..Default::default()
+    let opts3 = {
+        let mut opts = StableRegionsOptions::default();
+        opts.algorithm = Algorithm::Auto;
+        opts
     };
     let t = Instant::now();
     let r3 = stable_pairs_auto(&w, &areas_a, &areas_b, &opts3)?;

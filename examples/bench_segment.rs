@@ -35,9 +35,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             "--refine-rounds" => {
                 let rounds: usize = args.next().ok_or("--refine-rounds N")?.parse()?;
-                seg_opts.refine = (rounds > 0).then_some(coseg::stable::RefineOptions {
-                    max_rounds: rounds,
-                    ..SegmentCollectionOptions::DEFAULT_REFINE
+                seg_opts.refine = (rounds > 0).then_some({
+                    let mut opts = SegmentCollectionOptions::DEFAULT_REFINE;
+                    opts.max_rounds = rounds;
+                    opts
                 });
             }
             _ => files.push(PathBuf::from(a)),

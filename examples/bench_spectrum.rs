@@ -51,9 +51,10 @@ fn main() {
             }
         };
         for &k in &ks {
-            let opts = SpectrumOptions {
-                threads,
-                ..SpectrumOptions::with_eigenpairs(k)
+            let opts = {
+                let mut opts = SpectrumOptions::with_eigenpairs(k);
+                opts.threads = threads;
+                opts
             };
             let mut times = Vec::new();
             let mut last = None;

@@ -64,10 +64,11 @@ fn main() -> anyhow::Result<()> {
             ("nearest", FinalMatch::Nearest),
             ("one-to-one", FinalMatch::default()),
         ] {
-            let options = ZoomOutOptions {
-                descriptor_weight,
-                final_match,
-                ..Default::default()
+            let options = {
+                let mut opts = ZoomOutOptions::default();
+                opts.descriptor_weight = descriptor_weight;
+                opts.final_match = final_match;
+                opts
             };
             let mut seconds = Vec::new();
             let mut map = Vec::new();

@@ -103,10 +103,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     let t = Instant::now();
     let graph = ShapeGraph::build(nodes.clone(), &graph_opts)?;
-    let co = CosegmentOptions {
-        regions,
-        area_fraction: alpha,
-        ..Default::default()
+    let co = {
+        let mut opts = CosegmentOptions::default();
+        opts.regions = regions;
+        opts.area_fraction = alpha;
+        opts
     };
     let seg = cosegment(&graph, &co)?;
     let seg_time = t.elapsed().as_secs_f64();
@@ -164,11 +165,12 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // Baseline: pairwise Algorithm 2 along the chain 0-1-2-…, ids carried by majority.
     let t = Instant::now();
     let a = seg.alpha;
-    let so = StableRegionsOptions {
-        pairs: regions,
-        p: Threshold::AreaFraction(a),
-        q: Threshold::AreaFraction(a),
-        ..Default::default()
+    let so = {
+        let mut opts = StableRegionsOptions::default();
+        opts.pairs = regions;
+        opts.p = Threshold::AreaFraction(a);
+        opts.q = Threshold::AreaFraction(a);
+        opts
     };
     // Each pair as `coseg pair` gives it by default (Algorithm 2, then its refinement), and raw.
     let pair_refine = RefineOptions::default();

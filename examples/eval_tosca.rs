@@ -84,136 +84,153 @@ impl Shape {
 /// `(name, options, post-processing)`.
 fn configs() -> Vec<(&'static str, StableRegionsOptions, Post)> {
     // Explicit inits: the configurations do not depend on the library's default.
-    let base = StableRegionsOptions {
-        init: Init::Extreme,
-        ..Default::default()
+    let base = {
+        let mut opts = StableRegionsOptions::default();
+        opts.init = Init::Extreme;
+        opts
     };
-    let auto = StableRegionsOptions {
-        algorithm: Algorithm::Auto,
-        ..base.clone()
+    let auto = {
+        let mut opts = base.clone();
+        opts.algorithm = Algorithm::Auto;
+        opts
     };
     vec![
         ("alg2-extreme", base.clone(), Post::None),
         (
             "alg2-random",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..base.clone()
+            {
+                let mut opts = base.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::None,
         ),
         (
             "alg2-extreme-remaining",
-            StableRegionsOptions {
-                area_reference: AreaReference::Remaining,
-                ..base.clone()
+            {
+                let mut opts = base.clone();
+                opts.area_reference = AreaReference::Remaining;
+                opts
             },
             Post::None,
         ),
         ("alg3-extreme", auto.clone(), Post::None),
         (
             "alg3-random",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..auto.clone()
+            {
+                let mut opts = auto.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::None,
         ),
         (
             "alg3-extreme-linear",
-            StableRegionsOptions {
-                t_search: TSearch::Linear,
-                ..auto.clone()
+            {
+                let mut opts = auto.clone();
+                opts.t_search = TSearch::Linear;
+                opts
             },
             Post::None,
         ),
         (
             "alg3-random-linear-cold",
-            StableRegionsOptions {
-                init: Init::Random,
-                t_search: TSearch::Linear,
-                warm_start: false,
-                ..auto.clone()
+            {
+                let mut opts = auto.clone();
+                opts.init = Init::Random;
+                opts.t_search = TSearch::Linear;
+                opts.warm_start = false;
+                opts
             },
             Post::None,
         ),
         (
             "alg2-random-refined",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..base.clone()
+            {
+                let mut opts = base.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::Refine,
         ),
         (
             "alg3-random-refined",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..auto.clone()
+            {
+                let mut opts = auto.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::Refine,
         ),
         (
             "alg2-random-mapped",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..base.clone()
+            {
+                let mut opts = base.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::RefineMap,
         ),
         (
             "alg2-random-mapped-iso",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..base.clone()
+            {
+                let mut opts = base.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::RefineMapIsometric,
         ),
         (
             "alg3-random-mapped-iso",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..auto.clone()
+            {
+                let mut opts = auto.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::RefineMapIsometric,
         ),
         (
             "alg2-random-mapped-auto",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..base.clone()
+            {
+                let mut opts = base.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::RefineMapAuto,
         ),
         (
             "alg3-random-mapped-auto",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..auto.clone()
+            {
+                let mut opts = auto.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::RefineMapAuto,
         ),
         (
             "alg2-random-oracle-map",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..base.clone()
+            {
+                let mut opts = base.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::RefineOracleMap(MapGuidedOptions::default().map_weight),
         ),
         (
             "alg2-random-oracle-transfer",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..base.clone()
+            {
+                let mut opts = base.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::RefineOracleMap(1e6),
         ),
         (
             "alg3-random-mapped",
-            StableRegionsOptions {
-                init: Init::Random,
-                ..auto.clone()
+            {
+                let mut opts = auto.clone();
+                opts.init = Init::Random;
+                opts
             },
             Post::RefineMap,
         ),
@@ -294,7 +311,17 @@ fn main() -> anyhow::Result<()> {
     let configs: Vec<_> = configs()
         .into_iter()
         .filter(|(n, _, _)| which == "all" || which.split(',').any(|w| w == *n))
-        .map(|(n, o, p)| (n, StableRegionsOptions { seed, ..o }, p))
+        .map(|(n, o, p)| {
+            (
+                n,
+                {
+                    let mut opts = o;
+                    opts.seed = seed;
+                    opts
+                },
+                p,
+            )
+        })
         .collect();
     println!("pipeline: {pipe:?}");
     // Per class: the first `shapes` indices present.
@@ -361,10 +388,11 @@ fn main() -> anyhow::Result<()> {
                         if nearest {
                             map_guided.point_map.zoomout.final_match = FinalMatch::Nearest;
                         }
-                        let options = SegmentPairOptions {
-                            regions: opts.clone(),
-                            map_step: MapStep::Options(map_guided),
-                            ..Default::default()
+                        let options = {
+                            let mut o2 = SegmentPairOptions::default();
+                            o2.regions = opts.clone();
+                            o2.map_step = MapStep::Options(map_guided);
+                            o2
                         };
                         Ok(segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions)
                     };

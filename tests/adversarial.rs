@@ -654,9 +654,10 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
     };
     let mut map_step = coseg::maps::MapGuidedOptions::default();
     map_step.point_map.zoomout.final_size = 40;
-    let options = SegmentPairOptions {
-        map_step: coseg::maps::MapStep::Options(map_step.clone()),
-        ..Default::default()
+    let options = {
+        let mut opts = SegmentPairOptions::default();
+        opts.map_step = coseg::maps::MapStep::Options(map_step.clone());
+        opts
     };
     let out = segment_pair(shape(0), shape(1), &options).unwrap();
     assert_eq!(out.fallbacks.len(), 1, "{:?}", out.fallbacks);
@@ -666,9 +667,10 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
         "{}",
         out.fallbacks[0]
     );
-    let without = SegmentPairOptions {
-        map_step: coseg::maps::MapStep::Off,
-        ..options.clone()
+    let without = {
+        let mut opts = options.clone();
+        opts.map_step = coseg::maps::MapStep::Off;
+        opts
     };
     let reference = segment_pair(shape(0), shape(1), &without).unwrap();
     assert!(reference.fallbacks.is_empty());
@@ -676,9 +678,10 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
     assert_eq!(out.regions.labels_a(), reference.regions.labels_a());
     // A wrong option is still the caller's error, not a fallback.
     map_step.map_weight = f64::NAN;
-    let bad = SegmentPairOptions {
-        map_step: coseg::maps::MapStep::Options(map_step),
-        ..options
+    let bad = {
+        let mut opts = options;
+        opts.map_step = coseg::maps::MapStep::Options(map_step);
+        opts
     };
     assert!(segment_pair(shape(0), shape(1), &bad).is_err());
 }

@@ -195,11 +195,12 @@ fn bad_inputs_are_errors() {
 fn band_table_uses_the_descriptors_vertex_areas() {
     let mesh = blob(2);
     let s = dense_spectrum(&mesh, 20).unwrap();
-    let opts = DescriptorOptions {
-        hks_count: 4,
-        wks_count: 4,
-        curvature_count: 4,
-        ..Default::default()
+    let opts = {
+        let mut opts = DescriptorOptions::default();
+        opts.hks_count = 4;
+        opts.wks_count = 4;
+        opts.curvature_count = 4;
+        opts
     };
     let f = descriptors(&mesh, &s, &opts).unwrap();
     let count = band_table(&f, &BandOptions::default()).unwrap();
@@ -207,13 +208,12 @@ fn band_table_uses_the_descriptors_vertex_areas() {
         count,
         equal_count_bands(&f.values, 12, f.vertices, 20).unwrap()
     );
-    let area = band_table(
-        &f,
-        &BandOptions {
-            bands: 20,
-            weighting: BandWeighting::Area,
-        },
-    )
+    let area = band_table(&f, &{
+        let mut opts = BandOptions::default();
+        opts.bands = 20;
+        opts.weighting = BandWeighting::Area;
+        opts
+    })
     .unwrap();
     assert_eq!(
         area,

@@ -111,6 +111,28 @@ fn broken_file_is_reported_and_skipped_with_exit_3_and_strict_fails() {
     assert!(!strict_out.join("summary.json").exists());
 }
 
+/// `--parts auto` printed its "parts: …" line under `--quiet`.
+#[test]
+fn regression_quiet_parts_auto_prints_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 2, 2);
+    let out = dir.path().join("out");
+    let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
+    args.extend(FAST);
+    args.extend(["--parts", "auto"]);
+    let run = coseg(&args);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    assert!(run.stdout.is_empty(), "{}", text(&run.stdout));
+    assert!(run.stderr.is_empty(), "{}", text(&run.stderr));
+    let summary = std::fs::read_to_string(out.join("summary.json")).unwrap();
+    assert!(
+        summary.contains("\"parts\""),
+        "the parts report still goes to summary.json"
+    );
+}
+
 #[test]
 fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
     let dir = tempfile::tempdir().unwrap();

@@ -13,11 +13,12 @@ use coseg::output::{ExportFormat, ExportOptions, export_features};
 use coseg::spectral::{Spectrum, dense_spectrum};
 
 fn small_opts() -> DescriptorOptions {
-    DescriptorOptions {
-        hks_count: 16,
-        wks_count: 16,
-        curvature_count: 16,
-        ..Default::default()
+    {
+        let mut opts = DescriptorOptions::default();
+        opts.hks_count = 16;
+        opts.wks_count = 16;
+        opts.curvature_count = 16;
+        opts
     }
 }
 
@@ -297,9 +298,11 @@ fn a_vertex_permutation_permutes_features_and_bands() {
     for (new, &old) in perm.iter().enumerate() {
         assert_eq!(bp.row(new), b.row(old), "vertex {new} (was {old})");
     }
-    let area = BandOptions {
-        bands: 20,
-        weighting: coseg::bands::BandWeighting::Area,
+    let area = {
+        let mut opts = BandOptions::default();
+        opts.bands = 20;
+        opts.weighting = coseg::bands::BandWeighting::Area;
+        opts
     };
     let (a, ap) = (
         band_table(&f, &area).unwrap(),
@@ -367,15 +370,11 @@ fn export_writes_readable_npy_and_csv() {
     let ev: Vec<f64> = npy.into_vec().unwrap();
     assert_eq!(ev[3 * 20 + 5], s.eigenvector(5)[3]);
 
-    export_features(
-        dir.path(),
-        &f,
-        &b,
-        None,
-        &ExportOptions {
-            format: ExportFormat::Csv,
-        },
-    )
+    export_features(dir.path(), &f, &b, None, &{
+        let mut opts = ExportOptions::default();
+        opts.format = ExportFormat::Csv;
+        opts
+    })
     .unwrap();
     let text = std::fs::read_to_string(dir.path().join("descriptors.csv")).unwrap();
     let lines: Vec<&str> = text.lines().collect();

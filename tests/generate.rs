@@ -423,9 +423,10 @@ fn proportions_and_resolutions_vary_by_large_factors() {
 
 #[test]
 fn same_seed_same_bytes_different_seed_different_shapes() {
-    let options = GenerateOptions {
-        count: 2,
-        ..GenerateOptions::default()
+    let options = {
+        let mut opts = GenerateOptions::default();
+        opts.count = 2;
+        opts
     };
     let a = generate_family(Family::Humanoids, &options).unwrap();
     let b = generate_family(Family::Humanoids, &options).unwrap();
@@ -436,13 +437,11 @@ fn same_seed_same_bytes_different_seed_different_shapes() {
     // Shape i does not depend on the count.
     let full = collection(Family::Humanoids);
     assert_eq!(a.shapes[1].mesh, full.shapes[1].mesh);
-    let other = generate_family(
-        Family::Humanoids,
-        &GenerateOptions {
-            seed: 2,
-            ..options.clone()
-        },
-    )
+    let other = generate_family(Family::Humanoids, &{
+        let mut opts = options.clone();
+        opts.seed = 2;
+        opts
+    })
     .unwrap();
     for (x, y) in a.shapes.iter().zip(&other.shapes) {
         assert_ne!(x.mesh.positions(), y.mesh.positions());
@@ -452,13 +451,11 @@ fn same_seed_same_bytes_different_seed_different_shapes() {
 
 #[test]
 fn bad_count_is_an_error() {
-    let r = generate_family(
-        Family::Chairs,
-        &GenerateOptions {
-            count: 0,
-            ..GenerateOptions::default()
-        },
-    );
+    let r = generate_family(Family::Chairs, &{
+        let mut opts = GenerateOptions::default();
+        opts.count = 0;
+        opts
+    });
     assert!(r.is_err());
 }
 
@@ -546,9 +543,10 @@ fn shipped_files_agree_with_their_manifest() {
 #[test]
 fn write_collection_writes_manifest_that_round_trips() {
     let tmp = tempfile::tempdir().unwrap();
-    let options = GenerateOptions {
-        count: 1,
-        ..GenerateOptions::default()
+    let options = {
+        let mut opts = GenerateOptions::default();
+        opts.count = 1;
+        opts
     };
     let c = generate_family(Family::Goblets, &options).unwrap();
     write_collection(&c, &options, tmp.path()).unwrap();

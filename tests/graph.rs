@@ -68,10 +68,12 @@ fn two_cycle_is_exactly_algorithm_one() {
                         reference_area_a: ref_a,
                         reference_area_b: ref_b,
                     };
-                    let opts = StablePairOptions {
-                        p,
-                        q,
-                        max_iterations,
+                    let opts = {
+                        let mut opts = StablePairOptions::default();
+                        opts.p = p;
+                        opts.q = q;
+                        opts.max_iterations = max_iterations;
+                        opts
                     };
                     let pair = stable_pair(&w, &rem, &f0, &opts).unwrap();
                     let shapes = [
@@ -98,9 +100,12 @@ fn two_cycle_is_exactly_algorithm_one() {
                             direction: Direction::BtoA,
                         },
                     ];
-                    let cyc =
-                        stable_cycle(&shapes, &steps, &f0, &StableCycleOptions { max_iterations })
-                            .unwrap();
+                    let cyc = stable_cycle(&shapes, &steps, &f0, &{
+                        let mut opts = StableCycleOptions::default();
+                        opts.max_iterations = max_iterations;
+                        opts
+                    })
+                    .unwrap();
                     assert_eq!(cyc.regions[0], pair.region_a, "seed {seed} {p:?} {q:?}");
                     assert_eq!(cyc.regions[1], pair.region_b, "seed {seed} {p:?} {q:?}");
                     assert_eq!(cyc.objective.to_bits(), pair.objective.to_bits());
@@ -251,9 +256,10 @@ fn noisy_collection(n: usize, d: usize, seed: u64) -> (Vec<BandTable>, Vec<Vec<f
 fn cosegment_tuples_are_fixed_points_and_partition() {
     let (tables, areas) = noisy_collection(5, 200, 3);
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
-    let opts = CosegmentOptions {
-        regions: 5,
-        ..Default::default()
+    let opts = {
+        let mut opts = CosegmentOptions::default();
+        opts.regions = 5;
+        opts
     };
     let c = cosegment(&g, &opts).unwrap();
     assert_eq!(c.tuples.len(), 5);
@@ -308,14 +314,12 @@ fn cosegment_of_permuted_copies_gives_the_same_regions() {
     let areas: Vec<Vec<f64>> = perms.iter().map(|p| permute_values(&areas0, p)).collect();
     let mut g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
     g.set_feature_weights(Some(random_weights(40, 8))).unwrap();
-    let c = cosegment(
-        &g,
-        &CosegmentOptions {
-            regions: 4,
-            root: Some(0),
-            ..Default::default()
-        },
-    )
+    let c = cosegment(&g, &{
+        let mut opts = CosegmentOptions::default();
+        opts.regions = 4;
+        opts.root = Some(0);
+        opts
+    })
     .unwrap();
     let l0 = c.labels(0);
     for (i, p) in perms.iter().enumerate().skip(1) {
@@ -337,10 +341,11 @@ fn cosegment_is_deterministic() {
     let (tables, areas) = noisy_collection(6, 150, 5);
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
     for seed in [None, Some(42)] {
-        let o = CosegmentOptions {
-            regions: 4,
-            seed,
-            ..Default::default()
+        let o = {
+            let mut opts = CosegmentOptions::default();
+            opts.regions = 4;
+            opts.seed = seed;
+            opts
         };
         let a = cosegment(&g, &o).unwrap();
         let b = cosegment(&g, &o).unwrap();
@@ -355,21 +360,25 @@ fn cosegment_rejects_bad_options() {
     let (tables, areas) = noisy_collection(3, 60, 1);
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
     for o in [
-        CosegmentOptions {
-            regions: 0,
-            ..Default::default()
+        {
+            let mut opts = CosegmentOptions::default();
+            opts.regions = 0;
+            opts
         },
-        CosegmentOptions {
-            area_fraction: Some(1.5),
-            ..Default::default()
+        {
+            let mut opts = CosegmentOptions::default();
+            opts.area_fraction = Some(1.5);
+            opts
         },
-        CosegmentOptions {
-            root: Some(3),
-            ..Default::default()
+        {
+            let mut opts = CosegmentOptions::default();
+            opts.root = Some(3);
+            opts
         },
-        CosegmentOptions {
-            max_sweeps: 0,
-            ..Default::default()
+        {
+            let mut opts = CosegmentOptions::default();
+            opts.max_sweeps = 0;
+            opts
         },
     ] {
         assert!(cosegment(&g, &o).is_err(), "{o:?}");
@@ -406,10 +415,11 @@ fn large_collections_get_a_connected_nearest_neighbour_graph() {
         .collect();
     let tables: Vec<BandTable> = a.into_iter().chain(b).collect();
     let areas: Vec<Vec<f64>> = aa.iter().cloned().chain(aa.iter().cloned()).collect();
-    let opts = GraphOptions {
-        complete_limit: 10,
-        neighbours: 2,
-        ..Default::default()
+    let opts = {
+        let mut opts = GraphOptions::default();
+        opts.complete_limit = 10;
+        opts.neighbours = 2;
+        opts
     };
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &opts).unwrap();
     assert_eq!(g.kind(), GraphKind::Nearest(2));
@@ -429,13 +439,11 @@ fn large_collections_get_a_connected_nearest_neighbour_graph() {
         assert!(g.neighbours(i).len() >= 2);
     }
     // And the co-segmentation runs on it.
-    let c = cosegment(
-        &g,
-        &CosegmentOptions {
-            regions: 3,
-            ..Default::default()
-        },
-    )
+    let c = cosegment(&g, &{
+        let mut opts = CosegmentOptions::default();
+        opts.regions = 3;
+        opts
+    })
     .unwrap();
     assert_eq!(c.order.len(), 16);
     // Deterministic construction.
@@ -495,18 +503,18 @@ fn refine_cosegmentation_of_two_shapes_is_refine_partition() {
     for (regions, seed) in [(4, 5), (11, 6)] {
         let (tables, areas) = noisy_collection(2, 180, seed);
         let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
-        let c = cosegment(
-            &g,
-            &CosegmentOptions {
-                regions,
-                root: Some(1),
-                ..Default::default()
-            },
-        )
+        let c = cosegment(&g, &{
+            let mut opts = CosegmentOptions::default();
+            opts.regions = regions;
+            opts.root = Some(1);
+            opts
+        })
         .unwrap();
-        let opts = RefineOptions {
-            max_rounds: 20,
-            smoothing_time: 0.0,
+        let opts = {
+            let mut opts = RefineOptions::default();
+            opts.max_rounds = 20;
+            opts.smoothing_time = 0.0;
+            opts
         };
         let refined = refine_cosegmentation(&g, &c, None, &opts).unwrap();
         let w = BandAffinity::new(&tables[0], &tables[1]).unwrap();
@@ -530,17 +538,17 @@ fn refine_cosegmentation_reaches_a_fixed_point() {
     use coseg::stable::RefineOptions;
     let (tables, areas) = noisy_collection(5, 200, 7);
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
-    let c = cosegment(
-        &g,
-        &CosegmentOptions {
-            regions: 5,
-            ..Default::default()
-        },
-    )
+    let c = cosegment(&g, &{
+        let mut opts = CosegmentOptions::default();
+        opts.regions = 5;
+        opts
+    })
     .unwrap();
-    let opts = RefineOptions {
-        max_rounds: 50,
-        smoothing_time: 0.0,
+    let opts = {
+        let mut opts = RefineOptions::default();
+        opts.max_rounds = 50;
+        opts.smoothing_time = 0.0;
+        opts
     };
     let r = refine_cosegmentation(&g, &c, None, &opts).unwrap();
     assert!(r.tuples[0].converged, "no fixed point in 50 sweeps");
@@ -579,14 +587,12 @@ fn refine_cosegmentation_of_permuted_copies_agrees() {
     let tables: Vec<BandTable> = perms.iter().map(|p| permute_table(&base, p)).collect();
     let areas: Vec<Vec<f64>> = perms.iter().map(|p| permute_values(&areas0, p)).collect();
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
-    let c = cosegment(
-        &g,
-        &CosegmentOptions {
-            regions: 4,
-            root: Some(0),
-            ..Default::default()
-        },
-    )
+    let c = cosegment(&g, &{
+        let mut opts = CosegmentOptions::default();
+        opts.regions = 4;
+        opts.root = Some(0);
+        opts
+    })
     .unwrap();
     let r = refine_cosegmentation(&g, &c, None, &RefineOptions::default()).unwrap();
     let l0 = r.labels(0);
@@ -611,9 +617,10 @@ fn segment_collection_is_cosegment_then_refinement() {
     let d = mesh.vertex_count();
     let (tables, areas) = noisy_collection(4, d, 11);
     let meshes = vec![mesh; 4];
-    let mut opts = SegmentCollectionOptions {
-        refine: None,
-        ..Default::default()
+    let mut opts = {
+        let mut opts = SegmentCollectionOptions::default();
+        opts.refine = None;
+        opts
     };
     opts.cosegment.regions = 4;
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &opts.graph).unwrap();
@@ -621,9 +628,11 @@ fn segment_collection_is_cosegment_then_refinement() {
     let out = segment_collection(nodes_from(&tables, &areas), &[], &opts).unwrap();
     assert_eq!(out.segmentation, raw);
 
-    let refine = RefineOptions {
-        max_rounds: 7,
-        smoothing_time: 0.01,
+    let refine = {
+        let mut opts = RefineOptions::default();
+        opts.max_rounds = 7;
+        opts.smoothing_time = 0.01;
+        opts
     };
     opts.refine = Some(refine.clone());
     let smoothers: Vec<HeatSmoother> = meshes

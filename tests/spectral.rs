@@ -13,9 +13,10 @@ use std::f64::consts::PI;
 
 /// Options forcing the sparse path even on small meshes.
 fn sparse_opts(k: usize) -> SpectrumOptions {
-    SpectrumOptions {
-        dense_below: 0,
-        ..SpectrumOptions::with_eigenpairs(k)
+    {
+        let mut opts = SpectrumOptions::with_eigenpairs(k);
+        opts.dense_below = 0;
+        opts
     }
 }
 
@@ -178,9 +179,10 @@ fn icosphere_has_spherical_harmonic_clusters_and_skips_nothing() {
     let lmax = 9;
     let k = (lmax + 1) * (lmax + 1);
     for block in [8, 1] {
-        let opts = SpectrumOptions {
-            block_size: block,
-            ..SpectrumOptions::with_eigenpairs(k)
+        let opts = {
+            let mut opts = SpectrumOptions::with_eigenpairs(k);
+            opts.block_size = block;
+            opts
         };
         let s = laplace_beltrami_spectrum(&mesh, &opts).unwrap();
         assert_eq!(s.eigenvalues[0], 0.0);
@@ -340,9 +342,10 @@ fn bad_requests_are_typed_errors() {
         laplace_beltrami_spectrum(&mesh, &SpectrumOptions::with_eigenpairs(10)),
         Err(SpectralError::TooManyEigenpairs { .. })
     ));
-    let opts = SpectrumOptions {
-        shift: 0.5,
-        ..SpectrumOptions::with_eigenpairs(3)
+    let opts = {
+        let mut opts = SpectrumOptions::with_eigenpairs(3);
+        opts.shift = 0.5;
+        opts
     };
     assert!(matches!(
         laplace_beltrami_spectrum(&mesh, &opts),
@@ -365,9 +368,10 @@ fn coseg_chairs_if_data_present() {
         let Ok(mesh) = coseg::mesh::read_mesh(dir.join(name)) else {
             continue;
         };
-        let opts = SpectrumOptions {
-            dense_below: 0,
-            ..SpectrumOptions::with_eigenpairs(30)
+        let opts = {
+            let mut opts = SpectrumOptions::with_eigenpairs(30);
+            opts.dense_below = 0;
+            opts
         };
         let (s, stats) = coseg::spectral::laplace_beltrami_spectrum_with_stats(&mesh, &opts)
             .unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -444,12 +448,13 @@ mod zoomout_map {
     use coseg::spectral::{Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
 
     fn options() -> ZoomOutOptions {
-        ZoomOutOptions {
-            initial_size: 6,
-            final_size: 40,
-            step: 5,
-            samples: 300,
-            ..Default::default()
+        {
+            let mut opts = ZoomOutOptions::default();
+            opts.initial_size = 6;
+            opts.final_size = 40;
+            opts.step = 5;
+            opts.samples = 300;
+            opts
         }
     }
 
@@ -518,9 +523,10 @@ mod zoomout_map {
             .collect();
         let (ga, gb) = (geometry(&sa, &a), geometry(&sb, &b));
         let run = |final_match: FinalMatch| {
-            let options = ZoomOutOptions {
-                final_match,
-                ..options()
+            let options = {
+                let mut opts = options();
+                opts.final_match = final_match;
+                opts
             };
             zoomout(ga, gb, &start, &options).unwrap()
         };
@@ -577,12 +583,13 @@ mod zoomout_map {
         sizes.initial_size = 6;
         sizes.step = 0;
         assert!(zoomout(ga, gb, &truth, &sizes).is_err());
-        let no_candidates = ZoomOutOptions {
-            final_match: FinalMatch::Bijective {
+        let no_candidates = {
+            let mut opts = options();
+            opts.final_match = FinalMatch::Bijective {
                 candidates: 0,
                 auction: Default::default(),
-            },
-            ..options()
+            };
+            opts
         };
         assert!(zoomout(ga, gb, &truth, &no_candidates).is_err());
         let short = ShapeGeometry {
@@ -627,14 +634,16 @@ mod zoomout_descriptors {
         };
         let truth: Vec<u32> = perm.iter().map(|&o| o as u32).collect();
         let run = |weight: f64| {
-            let options = ZoomOutOptions {
-                initial_size: 6,
-                final_size: 40,
-                step: 5,
-                samples: 300,
-                descriptor_weight: weight,
-                // One-to-one matching would hide what the descriptors add.
-                final_match: FinalMatch::Nearest,
+            let options = {
+                let mut opts = ZoomOutOptions::default();
+                opts.initial_size = 6;
+                opts.final_size = 40;
+                opts.step = 5;
+                opts.samples = 300;
+                opts.descriptor_weight = weight;
+                opts.// One-to-one matching would hide what the descriptors add.
+                final_match = FinalMatch::Nearest;
+                opts
             };
             zoomout(ga, gb, &truth, &options)
         };
@@ -733,7 +742,7 @@ mod auction {
             raw in proptest::collection::vec(0.0f64..10.0, 49),
         ) {
             let costs = &raw[..n * n];
-            let options = AuctionOptions { penalty: 1e9, ..Default::default() };
+            let options = { let mut opts = AuctionOptions::default(); opts.penalty = 1e9; opts };
             let candidates = lists(costs, n);
             let out = auction_assignment(&candidates, n, &options).unwrap();
             let mut seen = out.map.clone();
@@ -763,9 +772,10 @@ mod auction {
         let out = auction_assignment(&lists(&costs, 3), 3, &AuctionOptions::default()).unwrap();
         assert_eq!(out.map, vec![1, 2, 0]);
         // Penalty 0: nobody pays to be exclusive, every query keeps its nearest target.
-        let greedy = AuctionOptions {
-            penalty: 0.0,
-            ..Default::default()
+        let greedy = {
+            let mut opts = AuctionOptions::default();
+            opts.penalty = 0.0;
+            opts
         };
         let out = auction_assignment(&lists(&costs, 3), 3, &greedy).unwrap();
         assert_eq!(out.map, vec![0, 0, 0]);
@@ -834,17 +844,20 @@ mod auction {
         empty_lists.per_query = 0;
         assert!(auction_assignment(&empty_lists, 2, &options).is_err());
         for bad in [
-            AuctionOptions {
-                epsilon: 0.0,
-                ..Default::default()
+            {
+                let mut opts = AuctionOptions::default();
+                opts.epsilon = 0.0;
+                opts
             },
-            AuctionOptions {
-                penalty: f64::INFINITY,
-                ..Default::default()
+            {
+                let mut opts = AuctionOptions::default();
+                opts.penalty = f64::INFINITY;
+                opts
             },
-            AuctionOptions {
-                epsilon: f64::NAN,
-                ..Default::default()
+            {
+                let mut opts = AuctionOptions::default();
+                opts.epsilon = f64::NAN;
+                opts
             },
         ] {
             assert!(auction_assignment(&good(), 2, &bad).is_err(), "{bad:?}");

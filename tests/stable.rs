@@ -239,10 +239,12 @@ fn algorithm1_fixed_sizes_returns_w_stable_pairs_with_monotone_objective() {
             .filter(|&p| x[p as usize] < 0.3)
             .collect();
         let (p, q) = (5 + (seed as usize % 11), 4 + (seed as usize % 13));
-        let opts = StablePairOptions {
-            p: Threshold::Count(p),
-            q: Threshold::Count(q),
-            max_iterations: 200,
+        let opts = {
+            let mut opts = StablePairOptions::default();
+            opts.p = Threshold::Count(p);
+            opts.q = Threshold::Count(q);
+            opts.max_iterations = 200;
+            opts
         };
         let pair = stable_pair(&w, &rem, &f0, &opts).unwrap();
         if !pair.converged {
@@ -379,9 +381,10 @@ fn algorithm2_partitions_recovers_a_relabelled_copy_and_is_deterministic() {
     let w = BandAffinity::new(&a, &b).unwrap();
     let map = VertexMap::Explicit(perm.iter().map(|&q| Some(q)).collect());
     for init in [Init::Extreme, Init::Random] {
-        let opts = StableRegionsOptions {
-            init,
-            ..Default::default()
+        let opts = {
+            let mut opts = StableRegionsOptions::default();
+            opts.init = init;
+            opts
         };
         let r = stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap();
         assert_eq!(r.pairs.len(), 10);
@@ -409,9 +412,10 @@ fn algorithm2_partitions_recovers_a_relabelled_copy_and_is_deterministic() {
         );
     }
     // Remaining-area reference: each pair takes 10 % of what is left.
-    let opts = StableRegionsOptions {
-        area_reference: AreaReference::Remaining,
-        ..Default::default()
+    let opts = {
+        let mut opts = StableRegionsOptions::default();
+        opts.area_reference = AreaReference::Remaining;
+        opts
     };
     let r = stable_pairs_fixed(&w, &areas_a, &areas_b, &opts).unwrap();
     assert_partition(&r);
@@ -424,10 +428,11 @@ fn algorithm2_random_init_depends_on_seed_only() {
     let b = latent_table(1700, 12, 8, 12);
     let (wa, wb) = (vec![1.0; 1500], vec![1.0; 1700]);
     let run = |seed| {
-        let opts = StableRegionsOptions {
-            init: Init::Random,
-            seed,
-            ..Default::default()
+        let opts = {
+            let mut opts = StableRegionsOptions::default();
+            opts.init = Init::Random;
+            opts.seed = seed;
+            opts
         };
         stable_regions(&a, &b, &wa, &wb, &opts).unwrap()
     };
@@ -440,10 +445,11 @@ fn algorithm3_partitions_and_reports_thresholds() {
     let a = latent_table(2000, 24, 10, 21);
     let (b, perm) = permuted(&a, 22);
     let areas = vec![1.0; 2000];
-    let opts = StableRegionsOptions {
-        algorithm: Algorithm::Auto,
-        pairs: 8,
-        ..Default::default()
+    let opts = {
+        let mut opts = StableRegionsOptions::default();
+        opts.algorithm = Algorithm::Auto;
+        opts.pairs = 8;
+        opts
     };
     let w = BandAffinity::new(&a, &b).unwrap();
     let r = stable_pairs_auto(&w, &areas, &areas, &opts).unwrap();
@@ -488,15 +494,17 @@ fn correspondence_ratio_counts_matches_and_checks_maps() {
 fn options_are_validated() {
     let a = latent_table(100, 4, 5, 1);
     let areas = vec![1.0; 100];
-    let zero = StableRegionsOptions {
-        pairs: 0,
-        ..Default::default()
+    let zero = {
+        let mut opts = StableRegionsOptions::default();
+        opts.pairs = 0;
+        opts
     };
     assert!(stable_regions(&a, &a, &areas, &areas, &zero).is_err());
-    let bad_dt = StableRegionsOptions {
-        algorithm: Algorithm::Auto,
-        delta_t: 0.0,
-        ..Default::default()
+    let bad_dt = {
+        let mut opts = StableRegionsOptions::default();
+        opts.algorithm = Algorithm::Auto;
+        opts.delta_t = 0.0;
+        opts
     };
     assert!(stable_regions(&a, &a, &areas, &areas, &bad_dt).is_err());
     assert!(
@@ -651,9 +659,11 @@ fn refine_partition_one_round_matches_dense_best_response() {
     let count = |q: usize, p: usize| (dense[q * da + p] / w.unit()).round();
     let new_b = best(&|q, r| mean_to(&la, r, &|p| count(q, p)), db);
     let new_a = best(&|p, r| mean_to(&new_b, r, &|q| count(q, p)), da);
-    let opts = RefineOptions {
-        max_rounds: 1,
-        smoothing_time: 0.0,
+    let opts = {
+        let mut opts = RefineOptions::default();
+        opts.max_rounds = 1;
+        opts.smoothing_time = 0.0;
+        opts
     };
     let r = refine_partition(&w, &la, &lb, None, None, &opts).unwrap();
     assert_eq!(r.labels_b, new_b);
@@ -671,9 +681,11 @@ fn refine_partition_converged_output_is_a_fixed_point() {
     let w = BandAffinity::new(&a, &b).unwrap();
     let la: Vec<i32> = (0..300).map(|p| p % 5).collect();
     let lb: Vec<i32> = (0..300).map(|q| (q / 60) % 5).collect();
-    let opts = RefineOptions {
-        max_rounds: 50,
-        smoothing_time: 0.0,
+    let opts = {
+        let mut opts = RefineOptions::default();
+        opts.max_rounds = 50;
+        opts.smoothing_time = 0.0;
+        opts
     };
     let r = refine_partition(&w, &la, &lb, None, None, &opts).unwrap();
     assert!(r.converged, "no fixed point within 50 rounds");
@@ -736,9 +748,10 @@ fn refine_regions_rebuilds_pairs_with_dense_objectives() {
     let (areas_a, areas_b) = (random_vec(120, 74), random_vec(100, 75));
     let w = BandAffinity::new(&a, &b).unwrap();
     let dense = dense_affinity(&w).unwrap();
-    let opts = StableRegionsOptions {
-        pairs: 4,
-        ..Default::default()
+    let opts = {
+        let mut opts = StableRegionsOptions::default();
+        opts.pairs = 4;
+        opts
     };
     let raw = stable_regions(&a, &b, &areas_a, &areas_b, &opts).unwrap();
     let r = refine_regions(
@@ -812,15 +825,17 @@ mod map_guided {
     }
 
     fn options() -> PointMapOptions {
-        PointMapOptions {
-            zoomout: ZoomOutOptions {
-                initial_size: 6,
-                final_size: 40,
-                step: 5,
-                samples: 300,
-                ..Default::default()
-            },
-            ..Default::default()
+        {
+            let mut o2 = PointMapOptions::default();
+            o2.zoomout = {
+                let mut opts = ZoomOutOptions::default();
+                opts.initial_size = 6;
+                opts.final_size = 40;
+                opts.step = 5;
+                opts.samples = 300;
+                opts
+            };
+            o2
         }
     }
 
@@ -982,10 +997,11 @@ mod map_guided {
         let w = BandAffinity::new(&da.bands, &db.bands).unwrap();
         let (ga, gb) = (geometry(&a, &da), geometry(&b, &db));
         let run = |weight: f64| {
-            let opts = MapGuidedOptions {
-                point_map: options(),
-                map_weight: weight,
-                ..Default::default()
+            let opts = {
+                let mut opts = MapGuidedOptions::default();
+                opts.point_map = options();
+                opts.map_weight = weight;
+                opts
             };
             map_guided_refinement(&w, &regions, ga, gb, None, &opts).unwrap()
         };
@@ -1026,17 +1042,11 @@ mod map_guided {
         let total: f64 = blended.pairs.iter().map(|p| p.area_fraction_b).sum();
         assert!((total - 1.0).abs() < 1e-9);
         assert!(
-            map_guided_refinement(
-                &w,
-                &regions,
-                ga,
-                gb,
-                None,
-                &MapGuidedOptions {
-                    map_weight: -1.0,
-                    ..Default::default()
-                }
-            )
+            map_guided_refinement(&w, &regions, ga, gb, None, &{
+                let mut opts = MapGuidedOptions::default();
+                opts.map_weight = -1.0;
+                opts
+            })
             .is_err()
         );
         // The same blend with the map handed in.
@@ -1075,18 +1085,22 @@ mod map_guided {
     #[test]
     fn segment_pair_equals_its_stages_run_by_hand() {
         let (a, b, _, da, db) = permuted_pair();
-        let options = SegmentPairOptions {
-            regions: StableRegionsOptions {
-                pairs: 6,
-                p: Threshold::AreaFraction(1.0 / 6.0),
-                q: Threshold::AreaFraction(1.0 / 6.0),
-                ..Default::default()
-            },
-            refine: Some(RefineOptions::default()),
-            map_step: MapStep::Options(MapGuidedOptions {
-                point_map: options(),
-                ..Default::default()
-            }),
+        let options = {
+            let mut o2 = SegmentPairOptions::default();
+            o2.regions = {
+                let mut opts = StableRegionsOptions::default();
+                opts.pairs = 6;
+                opts.p = Threshold::AreaFraction(1.0 / 6.0);
+                opts.q = Threshold::AreaFraction(1.0 / 6.0);
+                opts
+            };
+            o2.refine = Some(RefineOptions::default());
+            o2.map_step = MapStep::Options({
+                let mut opts = MapGuidedOptions::default();
+                opts.point_map = options();
+                opts
+            });
+            o2
         };
         let (sa, sb) = (pair_shape(&a, &da), pair_shape(&b, &db));
         let out = segment_pair(sa, sb, &options).unwrap();
@@ -1121,10 +1135,11 @@ mod map_guided {
         assert_eq!(out.regions, by_hand);
         assert_ne!(refined, raw, "the fixture should exercise the refinement");
 
-        let bare = SegmentPairOptions {
-            refine: None,
-            map_step: MapStep::Off,
-            ..options.clone()
+        let bare = {
+            let mut opts = options.clone();
+            opts.refine = None;
+            opts.map_step = MapStep::Off;
+            opts
         };
         let out = segment_pair(sa, sb, &bare).unwrap();
         assert_eq!(out.regions, raw);
@@ -1203,10 +1218,11 @@ fn stable_regions_are_exactly_invariant_to_the_order_of_features() {
     let areas_b: Vec<f64> = random_vec(1600, 35).iter().map(|x| 0.5 + x).collect();
     for algorithm in [Algorithm::Fixed, Algorithm::Auto] {
         for init in [Init::Extreme, Init::Random] {
-            let opts = StableRegionsOptions {
-                algorithm,
-                init,
-                ..Default::default()
+            let opts = {
+                let mut opts = StableRegionsOptions::default();
+                opts.algorithm = algorithm;
+                opts.init = init;
+                opts
             };
             let r = stable_regions(&a, &b, &areas_a, &areas_b, &opts).unwrap();
             let p = stable_regions(&pa, &pb, &areas_a, &areas_b, &opts).unwrap();

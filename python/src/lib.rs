@@ -9,8 +9,9 @@ use coseg::cache::CacheOutcome;
 use coseg::graph::{SegmentCollectionOptions, ShapeNode, load_collection, segment_collection};
 use coseg::labels::{LabelKind, PartNames, read_part_names, read_shape_labels};
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
-use coseg::output::{PropagationSummary, write_propagation, 
-    CollectionSummary, PairSummary, ShapeRegions, ShapeSummary, SkippedInput, write_regions,
+use coseg::output::{
+    CollectionSummary, PairSummary, PropagationSummary, ShapeRegions, ShapeSummary, SkippedInput,
+    write_propagation, write_regions,
 };
 use coseg::pipeline::{
     ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
@@ -692,10 +693,7 @@ type Annotations = (Vec<Option<Vec<i32>>>, Vec<SourceFile>, Vec<String>);
 /// The annotations of `shapes` (per vertex, `-1` = unlabelled) and the sources among them, or
 /// the error naming the shape whose labels do not fit it. An annotation without a labelled
 /// vertex is not used (a warning), as `coseg propagate` treats such a file.
-fn annotations_of(
-    shapes: &[Shape],
-    inputs: Vec<LabelInput>,
-) -> Result<Annotations, BoxError> {
+fn annotations_of(shapes: &[Shape], inputs: Vec<LabelInput>) -> Result<Annotations, BoxError> {
     if inputs.len() != shapes.len() {
         return Err(format!(
             "{} label entries for {} shapes (give None for an unlabelled shape)",

@@ -155,14 +155,17 @@ impl<'py> Opts<'py> {
             .unwrap_or(SegmentCollectionOptions::DEFAULT_REFINE);
         let rounds = self.take("refine_rounds")?.unwrap_or(base.max_rounds);
         let time = self.take("smoothing_time")?.unwrap_or(base.smoothing_time);
-        Ok(SegmentCollectionOptions {
-            graph,
-            cosegment: cos,
-            refine: (rounds > 0).then_some(RefineOptions {
-                max_rounds: rounds,
-                smoothing_time: time,
-            }),
-            ..d
+        Ok({
+            let mut o2 = d;
+            o2.graph = graph;
+            o2.cosegment = cos;
+            o2.refine = (rounds > 0).then_some({
+                let mut opts = RefineOptions::default();
+                opts.max_rounds = rounds;
+                opts.smoothing_time = time;
+                opts
+            });
+            o2
         })
     }
 
@@ -219,9 +222,11 @@ impl<'py> Opts<'py> {
         };
         Ok(PairOpts {
             regions: r,
-            refine: (rounds > 0).then_some(RefineOptions {
-                max_rounds: rounds,
-                smoothing_time: time,
+            refine: (rounds > 0).then_some({
+                let mut opts = RefineOptions::default();
+                opts.max_rounds = rounds;
+                opts.smoothing_time = time;
+                opts
             }),
             preset,
             map_weight: self.take("map_weight")?,
@@ -254,13 +259,15 @@ impl PairOpts {
             final_size: self.map_size,
             smoothing_time: self.map_smoothing_time,
         };
-        SegmentPairOptions {
-            regions: self.regions.clone(),
-            refine: self.refine.clone(),
-            map_step: match self.preset {
+        {
+            let mut opts = SegmentPairOptions::default();
+            opts.regions = self.regions.clone();
+            opts.refine = self.refine.clone();
+            opts.map_step = match self.preset {
                 None => MapStep::Auto(overrides),
                 Some(p) => MapStep::Preset(p, overrides),
-            },
+            };
+            opts
         }
     }
 }

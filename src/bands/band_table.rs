@@ -14,6 +14,7 @@ pub enum BandWeighting {
 
 /// Options of [`band_table`].
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct BandOptions {
     /// Number of bands `K` (default 20, as in the paper; `1..=256`).
     pub bands: usize,
@@ -40,9 +41,12 @@ impl Default for BandOptions {
 /// use coseg::bands::{band_table, BandOptions};
 /// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
 /// let s = dense_spectrum(&m, 4).unwrap();
-/// let opts = DescriptorOptions { hks_count: 2, wks_count: 2, curvature_count: 2, ..Default::default() };
+/// let mut opts = DescriptorOptions::default();
+/// (opts.hks_count, opts.wks_count, opts.curvature_count) = (2, 2, 2);
 /// let f = descriptors(&m, &s, &opts).unwrap();
-/// let t = band_table(&f, &BandOptions { bands: 2, ..Default::default() }).unwrap();
+/// let mut band_options = BandOptions::default();
+/// band_options.bands = 2;
+/// let t = band_table(&f, &band_options).unwrap();
 /// assert_eq!((t.vertices, t.features, t.bands), (4, 6, 2));
 /// ```
 pub fn band_table(

@@ -71,7 +71,11 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
         &data.descriptors,
         &data.bands,
         args.spectrum.then_some(&data.spectrum),
-        &ExportOptions { format },
+        &{
+            let mut opts = ExportOptions::default();
+            opts.format = format;
+            opts
+        },
     )?;
     println!(
         "{}: {} vertices, {} features, {} bands -> {} files in {}",

@@ -20,10 +20,11 @@ pub struct GenerateArgs {
 }
 
 pub fn run(args: GenerateArgs) -> Result<ExitCode> {
-    let options = GenerateOptions {
-        seed: args.seed,
-        count: args.count,
-        ..GenerateOptions::default()
+    let options = {
+        let mut opts = GenerateOptions::default();
+        opts.seed = args.seed;
+        opts.count = args.count;
+        opts
     };
     let targets: Vec<(Family, PathBuf)> = if args.family == "all" {
         Family::ALL

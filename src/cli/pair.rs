@@ -140,33 +140,34 @@ fn default_alpha() -> f64 {
 
 /// The algorithm's options the flags select.
 fn region_options(args: &PairArgs) -> StableRegionsOptions {
-    StableRegionsOptions {
-        algorithm: match args.algorithm {
+    {
+        let mut opts = StableRegionsOptions::default();
+        opts.algorithm = match args.algorithm {
             AlgorithmArg::Fixed => Algorithm::Fixed,
             AlgorithmArg::Auto => Algorithm::Auto,
-        },
-        pairs: args.pairs,
-        p: Threshold::AreaFraction(args.alpha),
-        q: Threshold::AreaFraction(args.alpha),
-        area_reference: if args.alpha_of_remaining {
+        };
+        opts.pairs = args.pairs;
+        opts.p = Threshold::AreaFraction(args.alpha);
+        opts.q = Threshold::AreaFraction(args.alpha);
+        opts.area_reference = if args.alpha_of_remaining {
             AreaReference::Remaining
         } else {
             AreaReference::Total
-        },
-        delta_t: args.delta_t,
-        t_max: args.t_max,
-        t_search: if args.linear_t {
+        };
+        opts.delta_t = args.delta_t;
+        opts.t_max = args.t_max;
+        opts.t_search = if args.linear_t {
             TSearch::Linear
         } else {
             TSearch::Bisect
-        },
-        init: match args.init {
+        };
+        opts.init = match args.init {
             InitArg::Extreme => Init::Extreme,
             InitArg::Random => Init::Random,
-        },
-        seed: args.seed,
-        max_iterations: args.max_iterations,
-        ..Default::default()
+        };
+        opts.seed = args.seed;
+        opts.max_iterations = args.max_iterations;
+        opts
     }
 }
 
@@ -245,14 +246,18 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     let options = region_options(&args);
     let (ma, da) = &loaded[0];
     let (mb, db) = &loaded[1];
-    let refine = (args.refine_rounds > 0).then_some(RefineOptions {
-        max_rounds: args.refine_rounds,
-        smoothing_time: args.smoothing_time,
+    let refine = (args.refine_rounds > 0).then_some({
+        let mut opts = RefineOptions::default();
+        opts.max_rounds = args.refine_rounds;
+        opts.smoothing_time = args.smoothing_time;
+        opts
     });
-    let pair_options = SegmentPairOptions {
-        regions: options,
-        refine,
-        map_step: map_step(&args),
+    let pair_options = {
+        let mut opts = SegmentPairOptions::default();
+        opts.regions = options;
+        opts.refine = refine;
+        opts.map_step = map_step(&args);
+        opts
     };
     let t = Instant::now();
     let spin = super::spinner("stable regions, refinement and map step");

@@ -137,13 +137,15 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
     let mut summary = CollectionSummary::new(&result, &files, &options, skipped);
     if let Some(a) = &result.adaptive {
         let report = PartsReport::new(a, seg, &loaded.meshes);
-        println!(
-            "parts: {} finest ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}",
-            a.leaves.tuples.len(),
-            a.stop,
-            seg.tuples.len(),
-            report.mirror_candidates
-        );
+        if !super::quiet() {
+            println!(
+                "parts: {} finest ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}",
+                a.leaves.tuples.len(),
+                a.stop,
+                seg.tuples.len(),
+                report.mirror_candidates
+            );
+        }
         summary.parts = Some(report);
     }
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
@@ -183,24 +185,29 @@ fn collection_options(
     pipeline: &ShapePipelineOptions,
     loaded: &LoadedCollection,
 ) -> SegmentCollectionOptions {
-    SegmentCollectionOptions {
-        graph: GraphOptions {
-            complete_limit: args.complete_limit,
-            neighbours: args.neighbours,
-            ..Default::default()
-        },
-        cosegment: CosegmentOptions {
-            regions: args.regions.unwrap_or(CosegmentOptions::default().regions),
-            area_fraction: args.area_fraction,
-            seed: args.seed,
-            ..Default::default()
-        },
-        refine: (args.refine_rounds > 0).then_some(RefineOptions {
-            max_rounds: args.refine_rounds,
-            smoothing_time: args.smoothing_time,
-        }),
-        feature_weights: pipeline.feature_weights(loaded.nodes[0].bands.features),
-        parts: args.parts.map(|p| {
+    {
+        let mut o2 = SegmentCollectionOptions::default();
+        o2.graph = {
+            let mut opts = GraphOptions::default();
+            opts.complete_limit = args.complete_limit;
+            opts.neighbours = args.neighbours;
+            opts
+        };
+        o2.cosegment = {
+            let mut opts = CosegmentOptions::default();
+            opts.regions = args.regions.unwrap_or(CosegmentOptions::default().regions);
+            opts.area_fraction = args.area_fraction;
+            opts.seed = args.seed;
+            opts
+        };
+        o2.refine = (args.refine_rounds > 0).then_some({
+            let mut opts = RefineOptions::default();
+            opts.max_rounds = args.refine_rounds;
+            opts.smoothing_time = args.smoothing_time;
+            opts
+        });
+        o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
+        o2.parts = args.parts.map(|p| {
             let mut o = AdaptiveOptions::default();
             if let PartsArg::Count(k) = p {
                 o.parts = Some(k);
@@ -211,7 +218,8 @@ fn collection_options(
             }
             o.seed = args.seed;
             o
-        }),
+        });
+        o2
     }
 }
 

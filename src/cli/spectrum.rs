@@ -42,27 +42,27 @@ pub struct SpectrumArgs {
 
 pub fn run(args: SpectrumArgs) -> Result<ExitCode> {
     let mesh = read_mesh(&args.mesh)?;
-    let options = SpectrumOptions {
-        eigenpairs: args.eigenpairs,
-        shift: args.shift,
-        tolerance: args.tolerance,
-        block_size: args.block_size,
-        seed: args.seed,
-        threads: args.solver_threads,
-        basis_size: args.basis_size,
-        ..SpectrumOptions::default()
+    let options = {
+        let mut opts = SpectrumOptions::default();
+        opts.eigenpairs = args.eigenpairs;
+        opts.shift = args.shift;
+        opts.tolerance = args.tolerance;
+        opts.block_size = args.block_size;
+        opts.seed = args.seed;
+        opts.threads = args.solver_threads;
+        opts.basis_size = args.basis_size;
+        opts
     };
-    let pipeline = coseg::pipeline::ShapePipelineOptions {
-        spectrum: options.clone(),
-        ..Default::default()
+    let pipeline = {
+        let mut opts = coseg::pipeline::ShapePipelineOptions::default();
+        opts.spectrum = options.clone();
+        opts
     };
     if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &pipeline) {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
-    let options = SpectrumOptions {
-        eigenpairs: options.eigenpairs.min(available_eigenpairs(&mesh)),
-        ..options
-    };
+    let mut options = options;
+    options.eigenpairs = options.eigenpairs.min(available_eigenpairs(&mesh));
     let (spectrum, stats) = laplace_beltrami_spectrum_with_stats(&mesh, &options)
         .with_context(|| format!("{}: spectrum", args.mesh.display()))?;
     if args.json {

@@ -9,6 +9,7 @@ use faer::Mat;
 
 /// Options of [`descriptors`]. Every field changes the result (and so belongs in a cache key).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct DescriptorOptions {
     /// Number of HKS features (default 100).
     pub hks_count: usize,
@@ -174,7 +175,8 @@ impl Descriptors {
 /// use coseg::features::{descriptors, DescriptorOptions};
 /// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
 /// let s = dense_spectrum(&m, 4).unwrap();
-/// let opts = DescriptorOptions { hks_count: 3, wks_count: 2, curvature_count: 1, ..Default::default() };
+/// let mut opts = DescriptorOptions::default();
+/// (opts.hks_count, opts.wks_count, opts.curvature_count) = (3, 2, 1);
 /// let f = descriptors(&m, &s, &opts).unwrap();
 /// assert_eq!(f.feature_count(), 6);
 /// assert_eq!(f.values.len(), 6 * 4);

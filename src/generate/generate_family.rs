@@ -6,6 +6,7 @@ use super::{Collection, Family, GenerateError, GeneratedShape, families};
 
 /// Options of [`generate_family`].
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct GenerateOptions {
     /// Seed of the parameter stream (default 1, the seed of the shipped collections).
     pub seed: u64,
@@ -34,7 +35,9 @@ impl Default for GenerateOptions {
 ///
 /// ```
 /// use coseg::generate::{generate_family, Family, GenerateOptions};
-/// let c = generate_family(Family::Chairs, &GenerateOptions { count: 1, ..Default::default() })
+/// let mut options = GenerateOptions::default();
+/// options.count = 1;
+/// let c = generate_family(Family::Chairs, &options)
 ///     .unwrap();
 /// assert_eq!(c.shapes[0].name, "chairs_00");
 /// ```

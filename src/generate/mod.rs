@@ -11,7 +11,8 @@
 //!
 //! ```
 //! use coseg::generate::{generate_family, Family, GenerateOptions};
-//! let options = GenerateOptions { count: 1, ..GenerateOptions::default() };
+//! let mut options = GenerateOptions::default();
+//! options.count = 1;
 //! let collection = generate_family(Family::Goblets, &options).unwrap();
 //! let shape = &collection.shapes[0];
 //! assert_eq!(shape.labels.len(), shape.mesh.vertex_count());

@@ -135,7 +135,8 @@ pub fn obj_text(mesh: &TriMesh, comment: &str) -> String {
 ///
 /// ```
 /// use coseg::generate::{generate_family, write_collection, Family, GenerateOptions};
-/// let options = GenerateOptions { count: 1, ..Default::default() };
+/// let mut options = GenerateOptions::default();
+/// options.count = 1;
 /// let c = generate_family(Family::Goblets, &options).unwrap();
 /// let dir = std::env::temp_dir().join("coseg_doc_write_collection");
 /// write_collection(&c, &options, &dir).unwrap();

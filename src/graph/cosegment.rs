@@ -63,6 +63,7 @@ use std::collections::VecDeque;
 
 /// Options of [`cosegment`].
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct CosegmentOptions {
     /// Number of regions per shape, the last being the leftovers (default 6).
     pub regions: usize,
@@ -750,7 +751,9 @@ pub fn cosegment_update(
 /// let t = equal_count_bands(&vals, 1, 12, 3).unwrap();
 /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 12]).unwrap()).collect();
 /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
-/// let c = cosegment(&g, &CosegmentOptions { regions: 3, ..Default::default() }).unwrap();
+/// let mut options = CosegmentOptions::default();
+/// options.regions = 3;
+/// let c = cosegment(&g, &options).unwrap();
 /// // Identical shapes: identical labels.
 /// assert_eq!(c.labels(0), c.labels(1));
 /// assert_eq!(c.labels(0), c.labels(2));

@@ -38,7 +38,9 @@ use rayon::prelude::*;
 ///     .map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &vec![1.0; 60]).unwrap())
 ///     .collect();
 /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
-/// let seg = cosegment(&g, &CosegmentOptions { regions: 3, ..Default::default() }).unwrap();
+/// let mut options = CosegmentOptions::default();
+/// options.regions = 3;
+/// let seg = cosegment(&g, &options).unwrap();
 /// let refined = refine_cosegmentation(&g, &seg, None, &RefineOptions::default()).unwrap();
 /// assert_eq!(refined.labels(0), refined.labels(1)); // identical shapes, identical ids
 /// ```

@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 
 /// Options of [`segment_collection`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
 pub struct SegmentCollectionOptions {
     /// How the shape graph is built (default: [`GraphOptions::default`]).
     pub graph: GraphOptions,

@@ -88,6 +88,7 @@ pub enum GraphKind {
 
 /// Options of [`ShapeGraph::build`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct GraphOptions {
     /// Collections of at most this many shapes get a complete graph (default 12: 66 edges).
     pub complete_limit: usize,

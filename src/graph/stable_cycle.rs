@@ -54,6 +54,7 @@ pub struct StableCycle {
 
 /// Options of [`stable_cycle`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct StableCycleOptions {
     /// Round cap (default 100, as Algorithm 1's).
     pub max_iterations: usize,

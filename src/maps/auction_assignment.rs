@@ -31,6 +31,7 @@ impl CandidateLists {
 /// Options of [`auction_assignment`]. Costs are measured in units of the *cost scale*: the
 /// median over queries of the nearest candidate's cost.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct AuctionOptions {
     /// Extra cost, in cost-scale units, at which a query gives up exclusivity and shares its
     /// nearest target instead (default 20). `0` returns the nearest targets; larger values

@@ -7,6 +7,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options of the map step, [`crate::stable::map_guided_refinement`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct MapGuidedOptions {
     /// The point map's options.
     pub point_map: PointMapOptions,

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options of [`region_point_map`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct PointMapOptions {
     /// The ZoomOut stage; its `initial_size` `k₀` is also the size of the functional map
     /// fitted to the region indicators (default 10: about as many unknowns per row as there
@@ -74,11 +75,13 @@ pub struct MapShape<'a> {
 ///     faces.push([v, v + nx + 1, v + nx]);
 /// }}
 /// let mesh = TriMesh::new(pos.clone(), faces).unwrap();
-/// let spectrum = laplace_beltrami_spectrum(&mesh, &SpectrumOptions { eigenpairs: 12, ..Default::default() }).unwrap();
+/// let mut spectrum_options = SpectrumOptions::default();
+/// spectrum_options.eigenpairs = 12;
+/// let spectrum = laplace_beltrami_spectrum(&mesh, &spectrum_options).unwrap();
 /// let labels: Vec<i32> = (0..nx * ny).map(|i| i32::from(i % nx >= 4)).collect();
 /// let shape = MapShape { spectrum: &spectrum, positions: &pos, labels: &labels, descriptors: None };
-/// let zoomout = ZoomOutOptions { initial_size: 4, final_size: 12, step: 4, ..Default::default() };
-/// let options = PointMapOptions { zoomout, ..Default::default() };
+/// let mut options = PointMapOptions::default();
+/// (options.zoomout.initial_size, options.zoomout.final_size, options.zoomout.step) = (4, 12, 4);
 /// let map = region_point_map(&shape, &shape, &options).unwrap();
 /// // Every vertex lands on the same side of the cut.
 /// assert!(map.iter().enumerate().all(|(q, &p)| labels[q] == labels[p as usize]));

@@ -11,6 +11,7 @@ use serde::{Deserialize, Serialize};
 /// Options of [`zoomout`] (and of the ZoomOut stage of
 /// [`region_point_map`](crate::maps::region_point_map)).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct ZoomOutOptions {
     /// Size `k₀` of the first functional map (default 10).
     pub initial_size: usize,
@@ -118,11 +119,14 @@ pub struct ShapeGeometry<'a> {
 ///     faces.push([v, v + nx + 1, v + nx]);
 /// }}
 /// let mesh = TriMesh::new(pos.clone(), faces).unwrap();
-/// let spectrum = laplace_beltrami_spectrum(&mesh, &SpectrumOptions { eigenpairs: 12, ..Default::default() }).unwrap();
+/// let mut spectrum_options = SpectrumOptions::default();
+/// spectrum_options.eigenpairs = 12;
+/// let spectrum = laplace_beltrami_spectrum(&mesh, &spectrum_options).unwrap();
 /// let shape = ShapeGeometry { spectrum: &spectrum, positions: &pos, descriptors: None };
 /// // Start from the identity with every vertex of the middle row sent one step to the right.
 /// let start: Vec<u32> = (0..nx * ny).map(|i| if i / nx == 1 && i % nx < nx - 1 { i + 1 } else { i }).collect();
-/// let options = ZoomOutOptions { initial_size: 4, final_size: 12, step: 4, ..Default::default() };
+/// let mut options = ZoomOutOptions::default();
+/// (options.initial_size, options.final_size, options.step) = (4, 12, 4);
 /// let map = zoomout(shape, shape, &start, &options).unwrap();
 /// assert_eq!(map.len(), start.len());
 /// ```

@@ -109,7 +109,8 @@ impl CollectionSummary {
     /// let t = equal_count_bands(&[0.0, 1.0, 2.0, 3.0], 1, 4, 4).unwrap();
     /// let nodes: Vec<ShapeNode> =
     ///     (0..2).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 4]).unwrap()).collect();
-    /// let opts = SegmentCollectionOptions { refine: None, ..Default::default() };
+    /// let mut opts = SegmentCollectionOptions::default();
+    /// opts.refine = None;
     /// let out = segment_collection(nodes, &[], &opts).unwrap();
     /// let files = vec!["s0.obj".to_string(), "s1.obj".to_string()];
     /// let sum = CollectionSummary::new(&out, &files, &opts, vec![]);

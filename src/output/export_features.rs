@@ -18,6 +18,7 @@ pub enum ExportFormat {
 
 /// Options of [`export_features`].
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct ExportOptions {
     /// File format (default `.npy`).
     pub format: ExportFormat,

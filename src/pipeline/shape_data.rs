@@ -38,6 +38,7 @@ pub enum PipelineError {
 
 /// Every option of the per-shape stages; all of it goes into the cache key.
 #[derive(Debug, Clone, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct ShapePipelineOptions {
     /// Eigenpairs (default: 200).
     pub spectrum: SpectrumOptions,

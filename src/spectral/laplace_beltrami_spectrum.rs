@@ -8,6 +8,7 @@ use faer::{Mat, Par};
 /// Options of [`laplace_beltrami_spectrum`]. Every field has a documented default
 /// ([`SpectrumOptions::default`]); eigenvalues refer to the mesh scaled to unit total area.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
 pub struct SpectrumOptions {
     /// Number of eigenpairs `k` (default 200).
     pub eigenpairs: usize,

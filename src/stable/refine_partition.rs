@@ -9,6 +9,7 @@ use serde::{Deserialize, Serialize};
 
 /// Options of [`refine_partition`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct RefineOptions {
     /// Largest number of rounds (one round = B from A, then A from B); default 10. The
     /// refinement stops earlier when a round changes no label.

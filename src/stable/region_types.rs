@@ -35,6 +35,7 @@ pub enum TSearch {
 
 /// Options of [`stable_regions`], [`stable_pairs_fixed`] and [`stable_pairs_auto`].
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct StableRegionsOptions {
     /// Algorithm 2 or 3 (default [`Algorithm::Fixed`]).
     pub algorithm: Algorithm,

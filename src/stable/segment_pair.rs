@@ -19,6 +19,7 @@ use std::time::{Duration, Instant};
 /// ([`MapStep::Auto`]), which on two poses of one body is the configuration that scores
 /// best on the TOSCA within-class pairs (README, "Correspondence ratio").
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct SegmentPairOptions {
     /// Algorithm 2 or 3 and their options (default: Algorithm 2 at a 10 % area cutoff,
     /// 10 pairs, random initial indicators with seed 0).

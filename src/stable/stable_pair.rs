@@ -24,6 +24,7 @@ pub struct Remaining<'s> {
 
 /// Options of Algorithm 1.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
 pub struct StablePairOptions {
     /// `P`: the rule on B applied to `W f`.
     pub p: Threshold,
@@ -91,7 +92,8 @@ pub struct StableWorkspace {
 /// let areas = vec![1.0; 8];
 /// let rem = Remaining { vertices_a: &all, vertices_b: &all, areas_a: &areas, areas_b: &areas,
 ///     reference_area_a: 8.0, reference_area_b: 8.0 };
-/// let opts = StablePairOptions { p: Threshold::Count(4), q: Threshold::Count(4), max_iterations: 10 };
+/// let mut opts = StablePairOptions::default();
+/// (opts.p, opts.q, opts.max_iterations) = (Threshold::Count(4), Threshold::Count(4), 10);
 /// let pair = stable_pair(&w, &rem, &[7], &opts).unwrap();
 /// assert_eq!(pair.region_a, vec![4, 5, 6, 7]);
 /// assert_eq!(pair.region_b, vec![4, 5, 6, 7]);
