@@ -2,13 +2,13 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::maps::{MapOverrides, MapPreset, MapStep, NEAR_ISOMETRIC_DISCREPANCY};
+use coseg::maps::{MapOverrides, MapPreset, MapStep, NEAR_ISOMETRIC_DISCREPANCY, PresetChoice};
 use coseg::mesh::TriMesh;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, write_visuals};
 use coseg::pipeline::{PipelineError, ShapeData, ShapePipelineOptions, load_shape};
 use coseg::render::{RenderOptions, RenderShape};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
+    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions, SegmentedPair,
     StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
 };
 use std::path::{Path, PathBuf};
@@ -140,35 +140,33 @@ fn default_alpha() -> f64 {
 
 /// The algorithm's options the flags select.
 fn region_options(args: &PairArgs) -> StableRegionsOptions {
-    {
-        let mut opts = StableRegionsOptions::default();
-        opts.algorithm = match args.algorithm {
-            AlgorithmArg::Fixed => Algorithm::Fixed,
-            AlgorithmArg::Auto => Algorithm::Auto,
-        };
-        opts.pairs = args.pairs;
-        opts.p = Threshold::AreaFraction(args.alpha);
-        opts.q = Threshold::AreaFraction(args.alpha);
-        opts.area_reference = if args.alpha_of_remaining {
-            AreaReference::Remaining
-        } else {
-            AreaReference::Total
-        };
-        opts.delta_t = args.delta_t;
-        opts.t_max = args.t_max;
-        opts.t_search = if args.linear_t {
-            TSearch::Linear
-        } else {
-            TSearch::Bisect
-        };
-        opts.init = match args.init {
-            InitArg::Extreme => Init::Extreme,
-            InitArg::Random => Init::Random,
-        };
-        opts.seed = args.seed;
-        opts.max_iterations = args.max_iterations;
-        opts
-    }
+    let mut opts = StableRegionsOptions::default();
+    opts.algorithm = match args.algorithm {
+        AlgorithmArg::Fixed => Algorithm::Fixed,
+        AlgorithmArg::Auto => Algorithm::Auto,
+    };
+    opts.pairs = args.pairs;
+    opts.p = Threshold::AreaFraction(args.alpha);
+    opts.q = Threshold::AreaFraction(args.alpha);
+    opts.area_reference = if args.alpha_of_remaining {
+        AreaReference::Remaining
+    } else {
+        AreaReference::Total
+    };
+    opts.delta_t = args.delta_t;
+    opts.t_max = args.t_max;
+    opts.t_search = if args.linear_t {
+        TSearch::Linear
+    } else {
+        TSearch::Bisect
+    };
+    opts.init = match args.init {
+        InitArg::Extreme => Init::Extreme,
+        InitArg::Random => Init::Random,
+    };
+    opts.seed = args.seed;
+    opts.max_iterations = args.max_iterations;
+    opts
 }
 
 /// Both shapes through the per-shape pipeline (and the cache), warnings printed.
@@ -243,50 +241,10 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             .unwrap_or_else(|| args.output.join(".cache"))
     });
     let loaded = load_pair(&args, &pipe, cache.as_deref())?;
-    let options = region_options(&args);
-    let (ma, da) = &loaded[0];
-    let (mb, db) = &loaded[1];
-    let refine = (args.refine_rounds > 0).then_some({
-        let mut opts = RefineOptions::default();
-        opts.max_rounds = args.refine_rounds;
-        opts.smoothing_time = args.smoothing_time;
-        opts
-    });
-    let pair_options = {
-        let mut opts = SegmentPairOptions::default();
-        opts.regions = options;
-        opts.refine = refine;
-        opts.map_step = map_step(&args);
-        opts
-    };
+    let pair_options = segment_pair_options(&args);
+    let (ma, mb) = (&loaded[0].0, &loaded[1].0);
     let t = Instant::now();
-    let spin = super::spinner("stable regions, refinement and map step");
-    let pair = segment_pair(
-        PairShape {
-            mesh: ma,
-            spectrum: &da.spectrum,
-            bands: &da.bands,
-            descriptors: Some(&da.descriptors.values),
-        },
-        PairShape {
-            mesh: mb,
-            spectrum: &db.spectrum,
-            bands: &db.bands,
-            descriptors: Some(&db.descriptors.values),
-        },
-        &pair_options,
-    )
-    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
-    if let Some(b) = spin {
-        b.finish_and_clear();
-    }
-    for f in &pair.fallbacks {
-        super::warn(format_args!(
-            "{} x {}: {f}",
-            args.a.display(),
-            args.b.display()
-        ));
-    }
+    let pair = segment_loaded(&args, &loaded, &pair_options)?;
     let regions = pair.regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
@@ -301,18 +259,8 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     let (la, lb) = (regions.labels_a(), regions.labels_b());
     let summary = PairSummary::new(
         [
-            ShapeSummary {
-                name: na.clone(),
-                file: args.a.display().to_string(),
-                vertices: ma.vertex_count(),
-                area: ma.total_area(),
-            },
-            ShapeSummary {
-                name: nb.clone(),
-                file: args.b.display().to_string(),
-                vertices: mb.vertex_count(),
-                area: mb.total_area(),
-            },
+            shape_summary(&na, &args.a, ma),
+            shape_summary(&nb, &args.b, mb),
         ],
         &regions,
         &pair_options.regions,
@@ -342,7 +290,92 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     if super::quiet() {
         return Ok(ExitCode::SUCCESS);
     }
-    if let Some(choice) = pair.map_preset {
+    report(
+        &args,
+        pair.map_preset,
+        regions.pairs.len(),
+        seconds,
+        ratio,
+        written.len(),
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The whole pair stage's options the flags select: the flag-to-option translation kept in one
+/// place, out of `run`, next to [`region_options`] and [`map_step`] which it combines.
+fn segment_pair_options(args: &PairArgs) -> SegmentPairOptions {
+    let mut opts = SegmentPairOptions::default();
+    opts.regions = region_options(args);
+    opts.refine = (args.refine_rounds > 0).then(|| {
+        let mut refine = RefineOptions::default();
+        refine.max_rounds = args.refine_rounds;
+        refine.smoothing_time = args.smoothing_time;
+        refine
+    });
+    opts.map_step = map_step(args);
+    opts
+}
+
+/// [`segment_pair`] on the two loaded shapes behind a spinner, with the stages that fell back
+/// printed as warnings; apart from `run` so that it reads as load, segment, write, report.
+fn segment_loaded(
+    args: &PairArgs,
+    loaded: &[(TriMesh, ShapeData)],
+    pair_options: &SegmentPairOptions,
+) -> Result<SegmentedPair> {
+    let (ma, da) = &loaded[0];
+    let (mb, db) = &loaded[1];
+    let spin = super::spinner("stable regions, refinement and map step");
+    let pair = segment_pair(
+        PairShape {
+            mesh: ma,
+            spectrum: &da.spectrum,
+            bands: &da.bands,
+            descriptors: Some(&da.descriptors.values),
+        },
+        PairShape {
+            mesh: mb,
+            spectrum: &db.spectrum,
+            bands: &db.bands,
+            descriptors: Some(&db.descriptors.values),
+        },
+        pair_options,
+    )
+    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
+    for f in &pair.fallbacks {
+        super::warn(format_args!(
+            "{} x {}: {f}",
+            args.a.display(),
+            args.b.display()
+        ));
+    }
+    Ok(pair)
+}
+
+/// One shape's entry of `summary.json`, written the same way for A and B.
+fn shape_summary(name: &str, file: &Path, mesh: &TriMesh) -> ShapeSummary {
+    ShapeSummary {
+        name: name.to_string(),
+        file: file.display().to_string(),
+        vertices: mesh.vertex_count(),
+        area: mesh.total_area(),
+    }
+}
+
+/// The lines `coseg pair` prints when not quiet: only reads the run's results, so it is kept
+/// out of `run`.
+fn report(
+    args: &PairArgs,
+    map_preset: Option<PresetChoice>,
+    pairs: usize,
+    seconds: f64,
+    ratio: Option<f64>,
+    files: usize,
+) {
+    if let Some(choice) = map_preset {
         println!(
             "map step: {} preset (eigenvalue discrepancy {:.4}; near-isometric below {})",
             match choice.preset {
@@ -357,20 +390,19 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         "{} x {}: {} region pairs in {:.3} s{} -> {} files in {}",
         args.a.display(),
         args.b.display(),
-        regions.pairs.len(),
+        pairs,
         seconds,
         ratio.map_or(String::new(), |r| format!(
             ", correspondence ratio {:.2} %",
             100.0 * r
         )),
-        written.len(),
+        files,
         args.output.display()
     );
     if !args.no_pictures {
         let out = args.output.display();
         println!("pictures: {out}/preview.png; viewer: {out}/index.html");
     }
-    Ok(ExitCode::SUCCESS)
 }
 
 #[cfg(test)]

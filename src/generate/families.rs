@@ -222,8 +222,27 @@ fn humanoid(index: usize, p: &mut Params, clear: f64) -> (Model, Vec<Clearance>)
         ],
         0.04,
     );
-    let mut arms = Vec::new();
     let mut checks = Vec::new();
+    let arms = humanoid_arms(p, tw, top, arm_len, ar, &mut checks);
+    let legs = humanoid_legs(p, tw, lr, leg_len, clear, &mut checks);
+    let mut parts = vec![part(vec![torso], 0.0), head];
+    parts.extend(arms);
+    parts.extend(legs);
+    (Model { parts, blend: 0.05 }, checks)
+}
+
+/// The humanoid's two arms (parts 2 and 3), their clearance checks appended to `checks`; apart
+/// from [`humanoid`] to keep it short. Called between the body's and the legs' parameters,
+/// since the order of the draws fixes each shape.
+fn humanoid_arms(
+    p: &mut Params,
+    tw: f64,
+    top: f64,
+    arm_len: f64,
+    ar: f64,
+    checks: &mut Vec<Clearance>,
+) -> Vec<Option<Part>> {
+    let mut arms = Vec::new();
     for (k, (name, side)) in [("arm_left", 1.0), ("arm_right", -1.0)]
         .into_iter()
         .enumerate()
@@ -259,6 +278,19 @@ fn humanoid(index: usize, p: &mut Params, clear: f64) -> (Model, Vec<Clearance>)
             0.03,
         ));
     }
+    arms
+}
+
+/// The humanoid's two legs (parts 4 and 5), their clearance checks appended to `checks`;
+/// called after [`humanoid_arms`] so that the parameters are drawn in the same order.
+fn humanoid_legs(
+    p: &mut Params,
+    tw: f64,
+    lr: f64,
+    leg_len: f64,
+    clear: f64,
+    checks: &mut Vec<Clearance>,
+) -> Vec<Option<Part>> {
     let mut legs = Vec::new();
     for (k, (name, side)) in [("leg_left", 1.0), ("leg_right", -1.0)]
         .into_iter()
@@ -292,10 +324,7 @@ fn humanoid(index: usize, p: &mut Params, clear: f64) -> (Model, Vec<Clearance>)
             0.03,
         ));
     }
-    let mut parts = vec![part(vec![torso], 0.0), head];
-    parts.extend(arms);
-    parts.extend(legs);
-    (Model { parts, blend: 0.05 }, checks)
+    legs
 }
 
 /// Goblet or cup: bowl (open spherical shell), stem, foot (base), handle on odd-numbered

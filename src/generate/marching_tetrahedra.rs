@@ -120,7 +120,7 @@ pub fn marching_tetrahedra(grid: &ScalarGrid) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) 
                     if n_in == 0 || n_in == 4 {
                         continue;
                     }
-                    let mut vertex = |a: usize, b: usize| -> u32 {
+                    let vertex = |a: usize, b: usize| -> u32 {
                         let (ga, gb) = (ids[a], ids[b]);
                         let key = (ga.min(gb), ga.max(gb));
                         *edge_vertex.entry(key).or_insert_with(|| {
@@ -137,62 +137,75 @@ pub fn marching_tetrahedra(grid: &ScalarGrid) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) 
                             (positions.len() - 1) as u32
                         })
                     };
-                    // Doubled integer corner coordinates: edge midpoints are then integers,
-                    // and orientation is decided exactly on the midpoint surface.
-                    let c2 = |c: usize| CORNER[c].map(|x| 2 * x);
-                    let mid = |a: usize, b: usize| {
-                        let (x, y) = (c2(a), c2(b));
-                        [(x[0] + y[0]) / 2, (x[1] + y[1]) / 2, (x[2] + y[2]) / 2]
-                    };
-                    let (ins, outs): (Vec<usize>, Vec<usize>) =
-                        tet.iter().partition(|&&c| inside[c]);
-                    if n_in == 1 || n_in == 3 {
-                        let (lone, others) = if n_in == 1 {
-                            (ins[0], [outs[0], outs[1], outs[2]])
-                        } else {
-                            (outs[0], [ins[0], ins[1], ins[2]])
-                        };
-                        let m = others.map(|o| mid(lone, o));
-                        let n = icross(isub(m[1], m[0]), isub(m[2], m[0]));
-                        // Direction from inside to outside.
-                        let l = c2(lone);
-                        let s = others.iter().fold([0; 3], |acc, &o| iadd(acc, c2(o)));
-                        let towards_others = isub(s, [3 * l[0], 3 * l[1], 3 * l[2]]);
-                        let outward = if n_in == 1 {
-                            towards_others
-                        } else {
-                            ineg(towards_others)
-                        };
-                        let v = others.map(|o| vertex(lone, o));
-                        if idot(n, outward) > 0 {
-                            faces.push([v[0], v[1], v[2]]);
-                        } else {
-                            faces.push([v[0], v[2], v[1]]);
-                        }
-                    } else {
-                        let (n1, n2, p1, p2) = (ins[0], ins[1], outs[0], outs[1]);
-                        let m = [mid(n1, p1), mid(n1, p2), mid(n2, p2), mid(n2, p1)];
-                        let n = icross(isub(m[1], m[0]), isub(m[2], m[0]));
-                        let outward = isub(iadd(c2(p1), c2(p2)), iadd(c2(n1), c2(n2)));
-                        let q = [
-                            vertex(n1, p1),
-                            vertex(n1, p2),
-                            vertex(n2, p2),
-                            vertex(n2, p1),
-                        ];
-                        if idot(n, outward) > 0 {
-                            faces.push([q[0], q[1], q[2]]);
-                            faces.push([q[0], q[2], q[3]]);
-                        } else {
-                            faces.push([q[0], q[2], q[1]]);
-                            faces.push([q[0], q[3], q[2]]);
-                        }
-                    }
+                    tet_faces(tet, &inside, n_in, vertex, &mut faces);
                 }
             }
         }
     }
     (positions, faces)
+}
+
+/// The one or two triangles, oriented outwards, where the surface crosses tetrahedron `tet` of a
+/// cube (`n_in` of its corners `inside`, 1 to 3). Apart from [`marching_tetrahedra`] so that the
+/// grid walk and the shared edge vertices read on one screen; `vertex(a, b)` is the output vertex
+/// on the cube edge between corners `a` and `b`, and the order of its calls fixes the numbering.
+fn tet_faces(
+    tet: &[usize; 4],
+    inside: &[bool; 8],
+    n_in: usize,
+    mut vertex: impl FnMut(usize, usize) -> u32,
+    faces: &mut Vec<[u32; 3]>,
+) {
+    // Doubled integer corner coordinates: edge midpoints are then integers,
+    // and orientation is decided exactly on the midpoint surface.
+    let c2 = |c: usize| CORNER[c].map(|x| 2 * x);
+    let mid = |a: usize, b: usize| {
+        let (x, y) = (c2(a), c2(b));
+        [(x[0] + y[0]) / 2, (x[1] + y[1]) / 2, (x[2] + y[2]) / 2]
+    };
+    let (ins, outs): (Vec<usize>, Vec<usize>) = tet.iter().partition(|&&c| inside[c]);
+    if n_in == 1 || n_in == 3 {
+        let (lone, others) = if n_in == 1 {
+            (ins[0], [outs[0], outs[1], outs[2]])
+        } else {
+            (outs[0], [ins[0], ins[1], ins[2]])
+        };
+        let m = others.map(|o| mid(lone, o));
+        let n = icross(isub(m[1], m[0]), isub(m[2], m[0]));
+        // Direction from inside to outside.
+        let l = c2(lone);
+        let s = others.iter().fold([0; 3], |acc, &o| iadd(acc, c2(o)));
+        let towards_others = isub(s, [3 * l[0], 3 * l[1], 3 * l[2]]);
+        let outward = if n_in == 1 {
+            towards_others
+        } else {
+            ineg(towards_others)
+        };
+        let v = others.map(|o| vertex(lone, o));
+        if idot(n, outward) > 0 {
+            faces.push([v[0], v[1], v[2]]);
+        } else {
+            faces.push([v[0], v[2], v[1]]);
+        }
+    } else {
+        let (n1, n2, p1, p2) = (ins[0], ins[1], outs[0], outs[1]);
+        let m = [mid(n1, p1), mid(n1, p2), mid(n2, p2), mid(n2, p1)];
+        let n = icross(isub(m[1], m[0]), isub(m[2], m[0]));
+        let outward = isub(iadd(c2(p1), c2(p2)), iadd(c2(n1), c2(n2)));
+        let q = [
+            vertex(n1, p1),
+            vertex(n1, p2),
+            vertex(n2, p2),
+            vertex(n2, p1),
+        ];
+        if idot(n, outward) > 0 {
+            faces.push([q[0], q[1], q[2]]);
+            faces.push([q[0], q[2], q[3]]);
+        } else {
+            faces.push([q[0], q[2], q[1]]);
+            faces.push([q[0], q[3], q[2]]);
+        }
+    }
 }
 
 fn isub(a: [i32; 3], b: [i32; 3]) -> [i32; 3] {

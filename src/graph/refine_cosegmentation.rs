@@ -50,27 +50,8 @@ pub fn refine_cosegmentation(
     smoothers: Option<&[HeatSmoother]>,
     options: &RefineOptions,
 ) -> Result<Cosegmentation, GraphError> {
+    check_inputs(graph, coseg, smoothers, options)?;
     let n = graph.node_count();
-    if coseg.vertices.len() != n
-        || (0..n).any(|i| coseg.vertices[i] != graph.node(i).bands.vertices)
-    {
-        return Err(GraphError::BadOption(
-            "the co-segmentation does not belong to this graph".into(),
-        ));
-    }
-    if let Some(s) = smoothers
-        && (s.len() != n || (0..n).any(|i| s[i].vertex_count() != coseg.vertices[i]))
-    {
-        return Err(GraphError::BadOption(
-            "one heat smoother per shape, with the shape's vertex count, is needed".into(),
-        ));
-    }
-    if !(options.smoothing_time.is_finite() && options.smoothing_time >= 0.0) {
-        return Err(GraphError::BadOption(format!(
-            "smoothing_time = {} must be finite and non-negative",
-            options.smoothing_time
-        )));
-    }
     let regions = coseg.tuples.len();
     let mut labels: Vec<Vec<i32>> = (0..n).map(|i| coseg.labels(i)).collect();
     let mut margins: Vec<Vec<f64>> = coseg.vertices.iter().map(|&d| vec![0.0; d]).collect();
@@ -117,6 +98,53 @@ pub fn refine_cosegmentation(
             break;
         }
     }
+    Ok(refined(graph, coseg, &labels, &margins, rounds, converged))
+}
+
+/// The inputs must belong together and the smoothing time be usable; checked before any work so
+/// that a mismatch is the caller's error.
+fn check_inputs(
+    graph: &ShapeGraph,
+    coseg: &Cosegmentation,
+    smoothers: Option<&[HeatSmoother]>,
+    options: &RefineOptions,
+) -> Result<(), GraphError> {
+    let n = graph.node_count();
+    if coseg.vertices.len() != n
+        || (0..n).any(|i| coseg.vertices[i] != graph.node(i).bands.vertices)
+    {
+        return Err(GraphError::BadOption(
+            "the co-segmentation does not belong to this graph".into(),
+        ));
+    }
+    if let Some(s) = smoothers
+        && (s.len() != n || (0..n).any(|i| s[i].vertex_count() != coseg.vertices[i]))
+    {
+        return Err(GraphError::BadOption(
+            "one heat smoother per shape, with the shape's vertex count, is needed".into(),
+        ));
+    }
+    if !(options.smoothing_time.is_finite() && options.smoothing_time >= 0.0) {
+        return Err(GraphError::BadOption(format!(
+            "smoothing_time = {} must be finite and non-negative",
+            options.smoothing_time
+        )));
+    }
+    Ok(())
+}
+
+/// The refined co-segmentation: `coseg`'s tuples with the regions of the final `labels`, their
+/// area fractions and their area-weighted mean `margins` as confidence. Apart from
+/// [`refine_cosegmentation`] because it only summarises the finished sweeps.
+fn refined(
+    graph: &ShapeGraph,
+    coseg: &Cosegmentation,
+    labels: &[Vec<i32>],
+    margins: &[Vec<f64>],
+    rounds: usize,
+    converged: bool,
+) -> Cosegmentation {
+    let n = graph.node_count();
     let mut out = coseg.clone();
     for (r, tuple) in out.tuples.iter_mut().enumerate() {
         let (mut weighted, mut area_sum) = (0.0, 0.0);
@@ -143,7 +171,7 @@ pub fn refine_cosegmentation(
             0.0
         };
     }
-    Ok(out)
+    out
 }
 
 /// Regions are processed in blocks of this many lanes, each block an `[f32; LANES]` that the

@@ -87,28 +87,7 @@ pub fn export_features(
             put("bands.csv", csv(&bands.labels, n, &names))?;
         }
     }
-    let meta = serde_json::json!({
-        "vertices": d,
-        "features": n,
-        "bands": bands.bands,
-        "names": names,
-        "kinds": descriptors
-            .kinds()
-            .iter()
-            .map(|k| k.family().to_string())
-            .chain(descriptors.extra_names.iter().map(|n| extra_family(n)))
-            .collect::<Vec<_>>(),
-        "scales": descriptors
-            .kinds()
-            .iter()
-            .map(|k| Some(k.scale()))
-            .chain(descriptors.extra_names.iter().map(|_| None))
-            .collect::<Vec<_>>(),
-        "hks_times": descriptors.hks_times,
-        "wks_energies": descriptors.wks_energies,
-        "wks_sigma": descriptors.wks_sigma,
-        "curvature_times": descriptors.curvature_times,
-    });
+    let meta = features_meta(descriptors, bands, &names);
     put(
         "features.json",
         serde_json::to_vec_pretty(&meta).expect("plain JSON values serialise"),
@@ -142,6 +121,38 @@ pub fn export_features(
         }
     }
     Ok(written)
+}
+
+/// The contents of `features.json`; apart from [`export_features`] because it is a long literal
+/// of its own that says what the columns of the other files are.
+fn features_meta(
+    descriptors: &Descriptors,
+    bands: &BandTable,
+    names: &[String],
+) -> serde_json::Value {
+    let (d, n) = (descriptors.vertices, descriptors.feature_count());
+    serde_json::json!({
+        "vertices": d,
+        "features": n,
+        "bands": bands.bands,
+        "names": names,
+        "kinds": descriptors
+            .kinds()
+            .iter()
+            .map(|k| k.family().to_string())
+            .chain(descriptors.extra_names.iter().map(|n| extra_family(n)))
+            .collect::<Vec<_>>(),
+        "scales": descriptors
+            .kinds()
+            .iter()
+            .map(|k| Some(k.scale()))
+            .chain(descriptors.extra_names.iter().map(|_| None))
+            .collect::<Vec<_>>(),
+        "hks_times": descriptors.hks_times,
+        "wks_energies": descriptors.wks_energies,
+        "wks_sigma": descriptors.wks_sigma,
+        "curvature_times": descriptors.curvature_times,
+    })
 }
 
 fn npy<T: npyz::AutoSerialize + Copy>(data: &[T], shape: &[usize]) -> Result<Vec<u8>, OutputError> {

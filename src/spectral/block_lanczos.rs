@@ -218,26 +218,7 @@ pub(crate) fn largest_eigenpairs(
     let mut v = Mat::<f64>::zeros(n, m_max);
     let mut h = Mat::<f64>::zeros(m_max, m_max);
 
-    // Start block.
-    {
-        let mut w = v.as_mut().subcols_mut(0, b);
-        for jj in 0..b {
-            for x in col_mut(w.rb_mut(), jj).iter_mut() {
-                *x = rng.next_f64();
-            }
-        }
-        project_out(null, w.rb_mut(), par);
-        project_out(null, w.rb_mut(), par);
-        let norms = vec![1.0; b];
-        orthonormalise_block(
-            Mat::<f64>::zeros(n, 0).as_ref(),
-            null,
-            w,
-            &norms,
-            &mut rng,
-            par,
-        );
-    }
+    start_block(v.as_mut().subcols_mut(0, b), null, &mut rng, par);
     let mut j = b;
     let mut restarts = 0usize;
     let mut applications = 0usize;
@@ -245,43 +226,16 @@ pub(crate) fn largest_eigenpairs(
     let mut last_check = 0usize;
     let mut w = Mat::<f64>::zeros(n, b);
     loop {
-        // Apply the last block.
-        w.copy_from(v.as_ref().subcols(j - b, b));
-        apply(w.as_mut());
+        let r = lanczos_step(
+            apply,
+            null,
+            v.as_ref().subcols(0, j),
+            &mut h,
+            &mut w,
+            &mut rng,
+            par,
+        );
         applications += b;
-        let norms_in: Vec<f64> = (0..b)
-            .map(|i| {
-                let c = col(w.as_ref(), i);
-                dot(c, c).sqrt()
-            })
-            .collect();
-        project_out(null, w.as_mut(), par);
-        let vj = v.as_ref().subcols(0, j);
-        let mut c = project_out(vj, w.as_mut(), par);
-        project_out(null, w.as_mut(), par);
-        let c2 = project_out(vj, w.as_mut(), par);
-        c += &c2;
-        // H[:, block] = C, mirrored; the diagonal block symmetrised.
-        for col_i in 0..b {
-            let hc = j - b + col_i;
-            for row in 0..j {
-                h[(row, hc)] = c[(row, col_i)];
-            }
-        }
-        for col_i in 0..b {
-            let hc = j - b + col_i;
-            for row in 0..j - b {
-                h[(hc, row)] = h[(row, hc)];
-            }
-        }
-        for a in j - b..j {
-            for bb in a + 1..j {
-                let s = 0.5 * (h[(a, bb)] + h[(bb, a)]);
-                h[(a, bb)] = s;
-                h[(bb, a)] = s;
-            }
-        }
-        let r = orthonormalise_block(vj, null, w.as_mut(), &norms_in, &mut rng, par);
 
         let full = j + b > m_max;
         let want_check = full || (j >= nev + 2 * b && j - last_check >= check_every);
@@ -296,39 +250,10 @@ pub(crate) fn largest_eigenpairs(
             // Descending order.
             let order: Vec<usize> = (0..j).rev().collect();
             let theta: Vec<f64> = order.iter().map(|&i| s[i]).collect();
-            // Residual of Ritz pair: ‖R · Y_last‖.
-            let mut converged = 0usize;
-            for (rank, &idx) in order.iter().enumerate().take(nev) {
-                let mut res2 = 0.0;
-                for row in 0..b {
-                    let mut acc = 0.0;
-                    for l in row..b {
-                        acc += r[(row, l)] * u[(j - b + l, idx)];
-                    }
-                    res2 += acc * acc;
-                }
-                if res2.sqrt() <= p.tol * theta[rank].abs() {
-                    converged += 1;
-                } else {
-                    break;
-                }
-            }
+            let converged = count_converged(r.as_ref(), u, &order, &theta, nev, p.tol);
             if converged >= nev {
-                let mut y = Mat::<f64>::zeros(j, nev);
-                for (rank, &idx) in order.iter().enumerate().take(nev) {
-                    for row in 0..j {
-                        y[(row, rank)] = u[(row, idx)];
-                    }
-                }
-                let mut vectors = Mat::<f64>::zeros(n, nev);
-                matmul(
-                    vectors.as_mut(),
-                    Accum::Replace,
-                    v.as_ref().subcols(0, j),
-                    y.as_ref(),
-                    1.0,
-                    par,
-                );
+                let y = ritz_coefficients(u, &order, nev);
+                let vectors = ritz_vectors(v.as_ref().subcols(0, j), y.as_ref(), par);
                 return Ok(BlockLanczosResult {
                     values: theta[..nev].to_vec(),
                     vectors,
@@ -350,52 +275,188 @@ pub(crate) fn largest_eigenpairs(
                     let k = k.min(m_max - b);
                     k.max(nev)
                 };
-                let mut y = Mat::<f64>::zeros(j, keep);
-                for (rank, &idx) in order.iter().enumerate().take(keep) {
-                    for row in 0..j {
-                        y[(row, rank)] = u[(row, idx)];
-                    }
-                }
-                let mut kept = Mat::<f64>::zeros(n, keep);
-                matmul(
-                    kept.as_mut(),
-                    Accum::Replace,
-                    v.as_ref().subcols(0, j),
-                    y.as_ref(),
-                    1.0,
-                    par,
-                );
-                v.as_mut().subcols_mut(0, keep).copy_from(&kept);
-                drop(kept);
-                v.as_mut().subcols_mut(keep, b).copy_from(&w);
-                h.fill(0.0);
-                for (rank, &t) in theta.iter().enumerate().take(keep) {
-                    h[(rank, rank)] = t;
-                }
-                // H[new, kept] = R · Y_last.
-                for row in 0..b {
-                    for kc in 0..keep {
-                        let mut acc = 0.0;
-                        for l in row..b {
-                            acc += r[(row, l)] * y[(j - b + l, kc)];
-                        }
-                        h[(keep + row, kc)] = acc;
-                        h[(kc, keep + row)] = acc;
-                    }
-                }
-                j = keep + b;
+                let y = ritz_coefficients(u, &order, keep);
+                j = thick_restart(&mut v, &mut h, &w, r.as_ref(), y.as_ref(), &theta, par);
                 last_check = j;
                 continue;
             }
         }
-        // Append the new block.
-        v.as_mut().subcols_mut(j, b).copy_from(&w);
-        for row in 0..b {
-            for cc in 0..b {
-                h[(j + row, j - b + cc)] = r[(row, cc)];
-                h[(j - b + cc, j + row)] = r[(row, cc)];
-            }
-        }
+        append_block(&mut v, &mut h, &w, r.as_ref(), j);
         j += b;
+    }
+}
+
+/// Fills `w` (the first block of the basis) with random directions orthonormal to each other
+/// and to `null`; kept apart so the main loop reads as the Lanczos recurrence alone.
+fn start_block(mut w: MatMut<'_, f64>, null: MatRef<'_, f64>, rng: &mut SplitMix, par: Par) {
+    let n = w.nrows();
+    let b = w.ncols();
+    for jj in 0..b {
+        for x in col_mut(w.rb_mut(), jj).iter_mut() {
+            *x = rng.next_f64();
+        }
+    }
+    project_out(null, w.rb_mut(), par);
+    project_out(null, w.rb_mut(), par);
+    let norms = vec![1.0; b];
+    orthonormalise_block(Mat::<f64>::zeros(n, 0).as_ref(), null, w, &norms, rng, par);
+}
+
+/// One block Lanczos step on the basis `vj` (whose last block was the last one added): applies
+/// the operator to that block into `w`, records the projections in the matching columns of `h`
+/// and orthonormalises `w`, returning its `R`. Kept apart so that the restart logic around it
+/// fits on a screen.
+fn lanczos_step(
+    apply: &dyn Fn(MatMut<'_, f64>),
+    null: MatRef<'_, f64>,
+    vj: MatRef<'_, f64>,
+    h: &mut Mat<f64>,
+    w: &mut Mat<f64>,
+    rng: &mut SplitMix,
+    par: Par,
+) -> Mat<f64> {
+    let j = vj.ncols();
+    let b = w.ncols();
+    w.copy_from(vj.subcols(j - b, b));
+    apply(w.as_mut());
+    let norms_in: Vec<f64> = (0..b)
+        .map(|i| {
+            let c = col(w.as_ref(), i);
+            dot(c, c).sqrt()
+        })
+        .collect();
+    project_out(null, w.as_mut(), par);
+    let mut c = project_out(vj, w.as_mut(), par);
+    project_out(null, w.as_mut(), par);
+    let c2 = project_out(vj, w.as_mut(), par);
+    c += &c2;
+    store_projection(h, &c, j, b);
+    orthonormalise_block(vj, null, w.as_mut(), &norms_in, rng, par)
+}
+
+/// `H[:, block] = C`, mirrored, with the diagonal block symmetrised: `H` must stay exactly
+/// symmetric for the Rayleigh–Ritz step although `C` is only symmetric up to rounding.
+fn store_projection(h: &mut Mat<f64>, c: &Mat<f64>, j: usize, b: usize) {
+    for col_i in 0..b {
+        let hc = j - b + col_i;
+        for row in 0..j {
+            h[(row, hc)] = c[(row, col_i)];
+        }
+    }
+    for col_i in 0..b {
+        let hc = j - b + col_i;
+        for row in 0..j - b {
+            h[(hc, row)] = h[(row, hc)];
+        }
+    }
+    for a in j - b..j {
+        for bb in a + 1..j {
+            let s = 0.5 * (h[(a, bb)] + h[(bb, a)]);
+            h[(a, bb)] = s;
+            h[(bb, a)] = s;
+        }
+    }
+}
+
+/// How many of the leading (largest) Ritz pairs have converged, counted in order and stopping
+/// at the first that has not: the residual of a Ritz pair is `‖R · Y_last‖`, which needs only
+/// the last block's rows of the eigenvectors `u` of `H_j`, not a product with the basis.
+fn count_converged(
+    r: MatRef<'_, f64>,
+    u: MatRef<'_, f64>,
+    order: &[usize],
+    theta: &[f64],
+    nev: usize,
+    tol: f64,
+) -> usize {
+    let j = u.nrows();
+    let b = r.nrows();
+    let mut converged = 0usize;
+    for (rank, &idx) in order.iter().enumerate().take(nev) {
+        let mut res2 = 0.0;
+        for row in 0..b {
+            let mut acc = 0.0;
+            for l in row..b {
+                acc += r[(row, l)] * u[(j - b + l, idx)];
+            }
+            res2 += acc * acc;
+        }
+        if res2.sqrt() <= tol * theta[rank].abs() {
+            converged += 1;
+        } else {
+            break;
+        }
+    }
+    converged
+}
+
+/// The first `count` eigenvectors of `H_j` in `order`, as columns (`j × count`); shared by the
+/// final answer and the thick restart, which both lift them into the basis.
+fn ritz_coefficients(u: MatRef<'_, f64>, order: &[usize], count: usize) -> Mat<f64> {
+    let j = u.nrows();
+    let mut y = Mat::<f64>::zeros(j, count);
+    for (rank, &idx) in order.iter().enumerate().take(count) {
+        for row in 0..j {
+            y[(row, rank)] = u[(row, idx)];
+        }
+    }
+    y
+}
+
+/// Ritz vectors `V_j Y` (n × count) as one BLAS-3 product.
+fn ritz_vectors(vj: MatRef<'_, f64>, y: MatRef<'_, f64>, par: Par) -> Mat<f64> {
+    let mut vectors = Mat::<f64>::zeros(vj.nrows(), y.ncols());
+    matmul(vectors.as_mut(), Accum::Replace, vj, y, 1.0, par);
+    vectors
+}
+
+/// Thick restart: replaces the basis by the kept Ritz vectors (coefficients `y`, `j × keep`)
+/// followed by the pending block `w`, and rebuilds `H` as their Ritz values plus the coupling
+/// `R · Y_last` to the new block, which keeps the Lanczos relation of the module doc. Returns the
+/// new basis size.
+fn thick_restart(
+    v: &mut Mat<f64>,
+    h: &mut Mat<f64>,
+    w: &Mat<f64>,
+    r: MatRef<'_, f64>,
+    y: MatRef<'_, f64>,
+    theta: &[f64],
+    par: Par,
+) -> usize {
+    let j = y.nrows();
+    let keep = y.ncols();
+    let b = w.ncols();
+    let kept = ritz_vectors(v.as_ref().subcols(0, j), y, par);
+    v.as_mut().subcols_mut(0, keep).copy_from(&kept);
+    drop(kept);
+    v.as_mut().subcols_mut(keep, b).copy_from(w);
+    h.fill(0.0);
+    for (rank, &t) in theta.iter().enumerate().take(keep) {
+        h[(rank, rank)] = t;
+    }
+    // H[new, kept] = R · Y_last.
+    for row in 0..b {
+        for kc in 0..keep {
+            let mut acc = 0.0;
+            for l in row..b {
+                acc += r[(row, l)] * y[(j - b + l, kc)];
+            }
+            h[(keep + row, kc)] = acc;
+            h[(kc, keep + row)] = acc;
+        }
+    }
+    keep + b
+}
+
+/// Appends the orthonormalised block `w` after the basis `V_j` and its `R` as the sub- and
+/// super-diagonal blocks of `H`, the plain (non-restart) continuation of the recurrence.
+fn append_block(v: &mut Mat<f64>, h: &mut Mat<f64>, w: &Mat<f64>, r: MatRef<'_, f64>, j: usize) {
+    let b = w.ncols();
+    v.as_mut().subcols_mut(j, b).copy_from(w);
+    for row in 0..b {
+        for cc in 0..b {
+            h[(j + row, j - b + cc)] = r[(row, cc)];
+            h[(j - b + cc, j + row)] = r[(row, cc)];
+        }
     }
 }

@@ -129,17 +129,7 @@ pub fn segment_pair(
     b: PairShape<'_>,
     options: &SegmentPairOptions,
 ) -> Result<SegmentedPair, StableError> {
-    for (s, name) in [(a, "A"), (b, "B")] {
-        let d = s.mesh.vertex_count();
-        if s.bands.vertices != d || s.spectrum.vertex_count() != d {
-            return Err(StableError::BadOption(format!(
-                "shape {name}: a mesh of {d} vertices with a band table of {} and a spectrum \
-                 of {}",
-                s.bands.vertices,
-                s.spectrum.vertex_count()
-            )));
-        }
-    }
+    check_sizes(a, b)?;
     let resolved = options.map_step.resolve(a.spectrum, b.spectrum)?;
     let (map_guided_options, map_preset) = (resolved.options, resolved.preset);
     check_stage_options(options.refine.as_ref(), map_guided_options.as_ref())?;
@@ -181,55 +171,15 @@ pub fn segment_pair(
             });
         }
     };
-    let smoother = |mesh: &TriMesh, time: f64| -> Result<Option<HeatSmoother>, StableError> {
-        Ok((time > 0.0)
-            .then(|| HeatSmoother::new(mesh, time))
-            .transpose()?)
-    };
     if let Some(refine) = refine {
-        let t = Instant::now();
-        let result = (|| {
-            let (sa, sb) = (
-                smoother(a.mesh, refine.smoothing_time)?,
-                smoother(b.mesh, refine.smoothing_time)?,
-            );
-            times.smoothers += t.elapsed();
-            let t = Instant::now();
-            let out = refine_regions(
-                &w,
-                &regions,
-                &areas_a,
-                &areas_b,
-                sa.as_ref(),
-                sb.as_ref(),
-                refine,
-            );
-            times.refine = t.elapsed();
-            out
-        })();
-        match result {
+        let areas = (&areas_a[..], &areas_b[..]);
+        match refine_stage(&w, &regions, a, b, areas, refine, &mut times) {
             Ok(r) => regions = r,
             Err(e) => fallbacks.push(StageFallback::new(PairStage::Refine, &e.to_string())),
         }
     }
     if let Some(map_guided) = map_guided {
-        let t = Instant::now();
-        let result = (|| {
-            let sb = smoother(b.mesh, map_guided.smoothing_time)?;
-            times.smoothers += t.elapsed();
-            let t = Instant::now();
-            let out = map_guided_refinement(
-                &w,
-                &regions,
-                a.geometry(),
-                b.geometry(),
-                sb.as_ref(),
-                &fit_map_sizes(map_guided, a.spectrum.len().min(b.spectrum.len())),
-            );
-            times.map_guided = t.elapsed();
-            out
-        })();
-        match result {
+        match map_guided_stage(&w, &regions, a, b, map_guided, &mut times) {
             Ok(r) => regions = r,
             Err(e) => fallbacks.push(StageFallback::new(PairStage::MapGuided, &e.to_string())),
         }
@@ -241,6 +191,87 @@ pub fn segment_pair(
         map_guided: map_guided_options,
         map_preset,
     })
+}
+
+/// The shapes' mesh, band table and spectrum must describe the same vertices; checked first so
+/// that a mismatch is reported as the caller's error rather than failing inside a stage.
+fn check_sizes(a: PairShape<'_>, b: PairShape<'_>) -> Result<(), StableError> {
+    for (s, name) in [(a, "A"), (b, "B")] {
+        let d = s.mesh.vertex_count();
+        if s.bands.vertices != d || s.spectrum.vertex_count() != d {
+            return Err(StableError::BadOption(format!(
+                "shape {name}: a mesh of {d} vertices with a band table of {} and a spectrum \
+                 of {}",
+                s.bands.vertices,
+                s.spectrum.vertex_count()
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// A heat smoother on `mesh` at `time`, or none at time 0 (which means no smoothing).
+fn smoother(mesh: &TriMesh, time: f64) -> Result<Option<HeatSmoother>, StableError> {
+    Ok((time > 0.0)
+        .then(|| HeatSmoother::new(mesh, time))
+        .transpose()?)
+}
+
+/// The boundary-refinement stage with its smoothers, timed into `times`; its error becomes a
+/// fallback in [`segment_pair`], so it is returned rather than propagated there.
+fn refine_stage(
+    w: &BandAffinity<'_>,
+    regions: &StableRegions,
+    a: PairShape<'_>,
+    b: PairShape<'_>,
+    (areas_a, areas_b): (&[f64], &[f64]),
+    refine: &RefineOptions,
+    times: &mut PairTimes,
+) -> Result<StableRegions, StableError> {
+    let t = Instant::now();
+    let (sa, sb) = (
+        smoother(a.mesh, refine.smoothing_time)?,
+        smoother(b.mesh, refine.smoothing_time)?,
+    );
+    times.smoothers += t.elapsed();
+    let t = Instant::now();
+    let out = refine_regions(
+        w,
+        regions,
+        areas_a,
+        areas_b,
+        sa.as_ref(),
+        sb.as_ref(),
+        refine,
+    );
+    times.refine = t.elapsed();
+    out
+}
+
+/// The map step with B's smoother, timed into `times`; like [`refine_stage`], its error
+/// becomes a fallback in [`segment_pair`].
+fn map_guided_stage(
+    w: &BandAffinity<'_>,
+    regions: &StableRegions,
+    a: PairShape<'_>,
+    b: PairShape<'_>,
+    map_guided: &MapGuidedOptions,
+    times: &mut PairTimes,
+) -> Result<StableRegions, StableError> {
+    let t = Instant::now();
+    let sb = smoother(b.mesh, map_guided.smoothing_time)?;
+    times.smoothers += t.elapsed();
+    let t = Instant::now();
+    let out = map_guided_refinement(
+        w,
+        regions,
+        a.geometry(),
+        b.geometry(),
+        sb.as_ref(),
+        &fit_map_sizes(map_guided, a.spectrum.len().min(b.spectrum.len())),
+    );
+    times.map_guided = t.elapsed();
+    out
 }
 
 /// The options' own ranges, checked before any stage runs: a wrong option is the caller's
