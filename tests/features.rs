@@ -13,13 +13,11 @@ use coseg::output::{ExportFormat, ExportOptions, export_features};
 use coseg::spectral::{Spectrum, dense_spectrum};
 
 fn small_opts() -> DescriptorOptions {
-    {
-        let mut opts = DescriptorOptions::default();
-        opts.hks_count = 16;
-        opts.wks_count = 16;
-        opts.curvature_count = 16;
-        opts
-    }
+    let mut opts = DescriptorOptions::default();
+    opts.hks_count = 16;
+    opts.wks_count = 16;
+    opts.curvature_count = 16;
+    opts
 }
 
 /// A synthetic spectrum (not from a mesh) with deterministic pseudo-random entries.

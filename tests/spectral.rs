@@ -13,11 +13,9 @@ use std::f64::consts::PI;
 
 /// Options forcing the sparse path even on small meshes.
 fn sparse_opts(k: usize) -> SpectrumOptions {
-    {
-        let mut opts = SpectrumOptions::with_eigenpairs(k);
-        opts.dense_below = 0;
-        opts
-    }
+    let mut opts = SpectrumOptions::with_eigenpairs(k);
+    opts.dense_below = 0;
+    opts
 }
 
 /// `y = L x` for the mesh's cotangent Laplacian.
@@ -448,14 +446,12 @@ mod zoomout_map {
     use coseg::spectral::{Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
 
     fn options() -> ZoomOutOptions {
-        {
-            let mut opts = ZoomOutOptions::default();
-            opts.initial_size = 6;
-            opts.final_size = 40;
-            opts.step = 5;
-            opts.samples = 300;
-            opts
-        }
+        let mut opts = ZoomOutOptions::default();
+        opts.initial_size = 6;
+        opts.final_size = 40;
+        opts.step = 5;
+        opts.samples = 300;
+        opts
     }
 
     /// A = a blob, B = the same blob with its vertices permuted (`perm[new] = old`).

@@ -825,18 +825,16 @@ mod map_guided {
     }
 
     fn options() -> PointMapOptions {
-        {
-            let mut o2 = PointMapOptions::default();
-            o2.zoomout = {
-                let mut opts = ZoomOutOptions::default();
-                opts.initial_size = 6;
-                opts.final_size = 40;
-                opts.step = 5;
-                opts.samples = 300;
-                opts
-            };
-            o2
-        }
+        let mut o2 = PointMapOptions::default();
+        o2.zoomout = {
+            let mut opts = ZoomOutOptions::default();
+            opts.initial_size = 6;
+            opts.final_size = 40;
+            opts.step = 5;
+            opts.samples = 300;
+            opts
+        };
+        o2
     }
 
     /// Six compact patches: the sign of the dominant coordinate of each vertex.

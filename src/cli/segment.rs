@@ -185,42 +185,40 @@ fn collection_options(
     pipeline: &ShapePipelineOptions,
     loaded: &LoadedCollection,
 ) -> SegmentCollectionOptions {
-    {
-        let mut o2 = SegmentCollectionOptions::default();
-        o2.graph = {
-            let mut opts = GraphOptions::default();
-            opts.complete_limit = args.complete_limit;
-            opts.neighbours = args.neighbours;
-            opts
-        };
-        o2.cosegment = {
-            let mut opts = CosegmentOptions::default();
-            opts.regions = args.regions.unwrap_or(CosegmentOptions::default().regions);
-            opts.area_fraction = args.area_fraction;
-            opts.seed = args.seed;
-            opts
-        };
-        o2.refine = (args.refine_rounds > 0).then_some({
-            let mut opts = RefineOptions::default();
-            opts.max_rounds = args.refine_rounds;
-            opts.smoothing_time = args.smoothing_time;
-            opts
-        });
-        o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
-        o2.parts = args.parts.map(|p| {
-            let mut o = AdaptiveOptions::default();
-            if let PartsArg::Count(k) = p {
-                o.parts = Some(k);
-                o.max_parts = o.max_parts.max(k);
-            }
-            if let Some(r) = args.regions {
-                o.max_parts = r;
-            }
-            o.seed = args.seed;
-            o
-        });
-        o2
-    }
+    let mut o2 = SegmentCollectionOptions::default();
+    o2.graph = {
+        let mut opts = GraphOptions::default();
+        opts.complete_limit = args.complete_limit;
+        opts.neighbours = args.neighbours;
+        opts
+    };
+    o2.cosegment = {
+        let mut opts = CosegmentOptions::default();
+        opts.regions = args.regions.unwrap_or(CosegmentOptions::default().regions);
+        opts.area_fraction = args.area_fraction;
+        opts.seed = args.seed;
+        opts
+    };
+    o2.refine = (args.refine_rounds > 0).then_some({
+        let mut opts = RefineOptions::default();
+        opts.max_rounds = args.refine_rounds;
+        opts.smoothing_time = args.smoothing_time;
+        opts
+    });
+    o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
+    o2.parts = args.parts.map(|p| {
+        let mut o = AdaptiveOptions::default();
+        if let PartsArg::Count(k) = p {
+            o.parts = Some(k);
+            o.max_parts = o.max_parts.max(k);
+        }
+        if let Some(r) = args.regions {
+            o.max_parts = r;
+        }
+        o.seed = args.seed;
+        o
+    });
+    o2
 }
 
 /// preview.png, <name>.png and index.html, legends naming each region by its confidence.
