@@ -18,7 +18,7 @@
 //! `--refit-weight B`, `--update-relays true|false`;
 //! the per-shape pipeline as `coseg propagate` takes it: `--features spectral,extrinsic,sdf`,
 //! `--up y|pca|…`, `--directions N`, `--normals N` (extrinsic normal columns), `--family-weights extrinsic=2`, `--bands K`,
-//! `--area-bands`, `--eigenpairs N`. Chairs only: `--gt-swap STEMS:A=B` exchanges labels `A`
+//! `--area-bands`, `--eigenpairs N`, `--laplacian cotan|intrinsic-delaunay`. Chairs only: `--gt-swap STEMS:A=B` exchanges labels `A`
 //! and `B` of the ground truth of the listed shapes (annotations and scoring alike), e.g.
 //! `--gt-swap 101,102,103,109,110:1=3` (docs/PROPAGATION.md: those five files label the back
 //! 3 and the legs 1, the other seventeen the reverse).
@@ -259,6 +259,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--normals" => normals = val()?.parse()?,
             "--bands" => pipeline.bands.bands = val()?.parse()?,
             "--eigenpairs" => pipeline.spectrum.eigenpairs = val()?.parse()?,
+            "--laplacian" => pipeline.spectrum.laplacian = val()?.parse()?,
             "--area-bands" => pipeline.bands.weighting = BandWeighting::Area,
             "--gt-swap" => {
                 let v = val()?;

@@ -894,3 +894,230 @@ mod discrepancy {
         assert!(eigenvalue_discrepancy(&sa, &s1, 21).is_err());
     }
 }
+
+/// The intrinsic Delaunay Laplacian (`LaplacianKind::IntrinsicDelaunay`).
+mod intrinsic_delaunay {
+    use super::common::shapes::{icosphere, jitter};
+    use coseg::mesh::TriMesh;
+    use coseg::spectral::{
+        IntrinsicDelaunay, LaplacianKind, SurfaceOperators, laplace_beltrami_spectrum,
+    };
+    use faer::sparse::SparseColMat;
+
+    /// A flat `n × n` grid of rhombi with sides (1, 0) and (0.6, 0.8) (angle 53°), each cut
+    /// along its long diagonal (angles of 127° face it: not Delaunay) or its short one (every
+    /// triangle acute: the Delaunay triangulation of these points).
+    fn rhombus_grid(n: usize, long: bool) -> TriMesh {
+        let mut pos = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                pos.push([i as f64 + 0.6 * j as f64, 0.8 * j as f64, 0.0]);
+            }
+        }
+        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let mut faces = Vec::new();
+        for j in 0..n {
+            for i in 0..n {
+                let (p00, p10, p11, p01) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                if long {
+                    faces.extend([[p00, p10, p11], [p00, p11, p01]]);
+                } else {
+                    faces.extend([[p00, p10, p01], [p10, p11, p01]]);
+                }
+            }
+        }
+        TriMesh::new(pos, faces).unwrap()
+    }
+
+    fn dense(l: &SparseColMat<usize, f64>) -> Vec<Vec<f64>> {
+        let n = l.nrows();
+        let mut a = vec![vec![0.0; n]; n];
+        for t in l.triplet_iter() {
+            a[t.row][t.col] += *t.val;
+        }
+        a
+    }
+
+    fn max_abs_diff(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
+        a.iter()
+            .flatten()
+            .zip(b.iter().flatten())
+            .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()))
+    }
+
+    #[test]
+    fn flipping_the_long_diagonals_gives_the_delaunay_triangulations_operators() {
+        let n = 6;
+        let (bad, good) = (rhombus_grid(n, true), rhombus_grid(n, false));
+        let idt = IntrinsicDelaunay::new(&bad);
+        assert_eq!(idt.flips(), n * n, "one flip per rhombus");
+        assert_eq!(idt.frozen_edges(), 0);
+        let d = bad.vertex_count();
+        let (l_idt, l_good) = (
+            dense(&idt.laplacian(d)),
+            dense(&SurfaceOperators::new(&good).laplacian().clone()),
+        );
+        assert!(
+            max_abs_diff(&l_idt, &l_good) < 1e-12,
+            "{}",
+            max_abs_diff(&l_idt, &l_good)
+        );
+        let (m_idt, m_good) = (idt.vertex_areas(d), good.vertex_areas());
+        for (x, y) in m_idt.iter().zip(&m_good) {
+            assert!((x - y).abs() < 1e-13, "mass {x} vs {y}");
+        }
+        // The cotangent Laplacian of the bad triangulation has negative weights.
+        let l_bad = dense(&SurfaceOperators::new(&bad).laplacian().clone());
+        assert!(
+            l_bad
+                .iter()
+                .enumerate()
+                .any(|(i, r)| r.iter().enumerate().any(|(j, &v)| i != j && v > 1e-9))
+        );
+        // The spectrum on the flipped triangulation is that of the Delaunay one.
+        let mut o = coseg::spectral::SpectrumOptions::with_eigenpairs(12);
+        o.laplacian = LaplacianKind::IntrinsicDelaunay;
+        let s_idt = laplace_beltrami_spectrum(&bad, &o).unwrap();
+        let s_good = laplace_beltrami_spectrum(
+            &good,
+            &coseg::spectral::SpectrumOptions::with_eigenpairs(12),
+        )
+        .unwrap();
+        for (a, b) in s_idt.eigenvalues.iter().zip(&s_good.eigenvalues) {
+            assert!((a - b).abs() <= 1e-9 * b.max(1.0), "{a} vs {b}");
+        }
+        let s_bad =
+            laplace_beltrami_spectrum(&bad, &coseg::spectral::SpectrumOptions::with_eigenpairs(12))
+                .unwrap();
+        assert!(
+            (s_bad.eigenvalues[5] - s_good.eigenvalues[5]).abs() > 1e-3 * s_good.eigenvalues[5]
+        );
+    }
+
+    #[test]
+    fn random_planar_triangulations_become_delaunay_keep_linear_precision_and_area() {
+        for seed in 0..8u64 {
+            // A jittered flat grid whose cells are cut along a diagonal chosen by a hash.
+            let n = 9;
+            let mut pos = Vec::new();
+            for j in 0..=n {
+                for i in 0..=n {
+                    pos.push([i as f64, j as f64, 0.0]);
+                }
+            }
+            jitter(&mut pos, 0.3, seed);
+            for p in pos.iter_mut() {
+                p[2] = 0.0; // flat: linear precision is exact only in the plane
+            }
+            let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+            let mut faces = Vec::new();
+            for j in 0..n {
+                for i in 0..n {
+                    let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
+                    if (i * 7 + j * 13 + seed as usize) % 3 == 0 {
+                        faces.extend([[a, b, c], [a, c, d]]);
+                    } else {
+                        faces.extend([[a, b, d], [b, c, d]]);
+                    }
+                }
+            }
+            let mesh = TriMesh::new(pos.clone(), faces).unwrap();
+            let ops = SurfaceOperators::with_laplacian(&mesh, LaplacianKind::IntrinsicDelaunay);
+            let l = dense(&ops.laplacian().clone());
+            let dn = mesh.vertex_count();
+            // Delaunay: no positive off-diagonal entry (every edge weight ≥ 0) on the edges of
+            // interior vertices (boundary edges are not flipped and can face an obtuse angle).
+            let interior = |i: usize| {
+                let (gi, gj) = (i % (n + 1), i / (n + 1));
+                gi > 0 && gj > 0 && gi < n && gj < n
+            };
+            for i in (0..dn).filter(|&i| interior(i)) {
+                for j in 0..dn {
+                    assert!(
+                        i == j || l[i][j] <= 1e-12,
+                        "seed {seed}: L[{i}][{j}] = {}",
+                        l[i][j]
+                    );
+                }
+            }
+            // Linear precision: L x = 0 at interior vertices for linear x (a flat intrinsic
+            // triangulation is a flat triangulation: wrong flipped lengths would break this).
+            for c in 0..2 {
+                for i in (0..dn).filter(|&i| interior(i)) {
+                    let lx: f64 = (0..dn).map(|j| l[i][j] * pos[j][c]).sum();
+                    assert!(lx.abs() < 1e-10, "seed {seed}: (L x)_{i} = {lx}");
+                }
+            }
+            let area: f64 = ops.vertex_areas().iter().sum();
+            assert!((area - mesh.total_area()).abs() < 1e-12 * area);
+            assert_eq!(ops.faces(&mesh).len(), mesh.face_count());
+        }
+    }
+
+    #[test]
+    fn an_already_delaunay_mesh_is_left_as_it_is() {
+        let mesh = icosphere(3, 1.0);
+        let idt = IntrinsicDelaunay::new(&mesh);
+        assert_eq!(idt.flips(), 0);
+        assert_eq!(idt.faces(), mesh.faces());
+        let (a, b) = (
+            dense(&idt.laplacian(mesh.vertex_count())),
+            dense(&SurfaceOperators::new(&mesh).laplacian().clone()),
+        );
+        assert!(max_abs_diff(&a, &b) < 1e-12);
+    }
+
+    #[test]
+    fn non_manifold_misoriented_and_degenerate_input_is_survived() {
+        // Three triangles on edge 0–1 (non-manifold); a needle (5, 6, 7) and a zero-area
+        // triangle (1, 5, 6) that share edge 5–6 in the same direction (misoriented).
+        let pos = vec![
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [0.5, 1., 0.],
+            [0.5, -1., 0.],
+            [0.5, 0., 1.],
+            [2., 0., 0.],
+            [3., 0., 0.],
+            [2.5, 1e-9, 0.],
+        ];
+        let faces = vec![
+            [0, 1, 2],
+            [1, 0, 3],
+            [0, 1, 4],
+            [5, 6, 7],
+            [1, 5, 6],
+            [1, 6, 2],
+        ];
+        let mesh = TriMesh::new(pos, faces).unwrap();
+        let idt = IntrinsicDelaunay::new(&mesh);
+        assert_eq!(idt.frozen_edges(), 2);
+        let l = idt.laplacian(mesh.vertex_count());
+        assert!(l.triplet_iter().all(|t| t.val.is_finite()));
+        let rows = dense(&l);
+        for r in &rows {
+            assert!(r.iter().sum::<f64>().abs() < 1e-9, "L 1 = 0");
+        }
+    }
+
+    #[test]
+    fn the_laplacian_kind_is_in_the_cache_key_but_the_default_key_is_unchanged() {
+        use coseg::cache::entry_key;
+        use coseg::pipeline::ShapePipelineOptions;
+        let mesh = icosphere(1, 1.0);
+        let mut o = ShapePipelineOptions::default();
+        let default_key = entry_key(&mesh, &o);
+        o.spectrum.laplacian = LaplacianKind::IntrinsicDelaunay;
+        assert_ne!(entry_key(&mesh, &o), default_key);
+        // The default is left out of the serialised options: its bytes are those of the
+        // options without the field, so caches made before the option existed stay valid.
+        let bytes = |o: &coseg::spectral::SpectrumOptions| {
+            bincode::serde::encode_to_vec(o, bincode::config::standard()).unwrap()
+        };
+        let mut idt = coseg::spectral::SpectrumOptions::default();
+        idt.laplacian = LaplacianKind::IntrinsicDelaunay;
+        let (d, i) = (bytes(&Default::default()), bytes(&idt));
+        assert_eq!(&i[..d.len()], &d[..]);
+        assert!(i.len() > d.len());
+    }
+}

@@ -39,6 +39,11 @@ pub struct PipelineArgs {
     /// Number of normal columns of the extrinsic family (|normal · direction|; 0 = none).
     #[arg(long, default_value_t = 0)]
     normals: usize,
+    /// Triangulation of the spectral family's Laplacian: cotan (the mesh's triangles) or
+    /// intrinsic-delaunay (edges flipped intrinsically until every cotangent weight is
+    /// non-negative; for CAD exports and poor triangulations). See docs/FEATURES.md.
+    #[arg(long, default_value = "cotan")]
+    laplacian: String,
     /// Family weights in the affinity, e.g. spectral=1,extrinsic=2 (a family's total share;
     /// default 1 each). Used by `coseg segment` and `coseg propagate`; `coseg pair` weights every
     /// column equally.
@@ -58,6 +63,7 @@ impl PipelineArgs {
         parse_family_weights(&self.family_weights, &mut families.weights)?;
         opts.families = families;
         opts.spectrum.eigenpairs = self.eigenpairs;
+        opts.spectrum.laplacian = self.laplacian.parse().map_err(anyhow::Error::msg)?;
         opts.descriptors.hks_count = self.hks;
         opts.descriptors.wks_count = self.wks;
         opts.descriptors.curvature_count = self.curvature;

@@ -35,6 +35,9 @@ pub struct SpectrumArgs {
     /// Maximum Krylov basis size (default: about twice the eigenpairs computed).
     #[arg(long)]
     basis_size: Option<usize>,
+    /// Triangulation of the Laplacian: cotan (the mesh's triangles) or intrinsic-delaunay.
+    #[arg(long, default_value = "cotan")]
+    laplacian: String,
     /// Print solver statistics (timings, factor size) to stderr.
     #[arg(long)]
     stats: bool,
@@ -51,6 +54,7 @@ pub fn run(args: SpectrumArgs) -> Result<ExitCode> {
         opts.seed = args.seed;
         opts.threads = args.solver_threads;
         opts.basis_size = args.basis_size;
+        opts.laplacian = args.laplacian.parse().map_err(anyhow::Error::msg)?;
         opts
     };
     let pipeline = {

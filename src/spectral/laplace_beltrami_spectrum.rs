@@ -1,6 +1,6 @@
 use super::block_lanczos::{BlockLanczosParams, largest_eigenpairs};
 use super::shift_invert::{Pencil, ShiftInvert, count_below};
-use super::{SpectralError, Spectrum, SurfaceOperators, lumped_mass};
+use super::{LaplacianKind, SpectralError, Spectrum, SurfaceOperators, lumped_mass};
 use crate::mesh::TriMesh;
 use faer::reborrow::*;
 use faer::{Mat, Par};
@@ -49,6 +49,11 @@ pub struct SpectrumOptions {
     /// Meshes with at most this many vertices (of positive area) use the dense eigensolver
     /// (default 600). Smaller meshes than the Krylov basis always do.
     pub dense_below: usize,
+    /// The triangulation of the Laplacian and mass (default [`LaplacianKind::Cotangent`], the
+    /// mesh's own triangles; [`LaplacianKind::IntrinsicDelaunay`] for poor triangulations).
+    /// Left out of the serialised options when default, so default cache keys are unchanged.
+    #[serde(default, skip_serializing_if = "LaplacianKind::is_cotangent")]
+    pub laplacian: LaplacianKind,
 }
 
 impl Default for SpectrumOptions {
@@ -65,6 +70,7 @@ impl Default for SpectrumOptions {
             threads: 1,
             polish: true,
             dense_below: 600,
+            laplacian: LaplacianKind::Cotangent,
         }
     }
 }
@@ -207,7 +213,7 @@ pub fn laplace_beltrami_spectrum_with_stats(
             vertices: d,
         });
     }
-    let ops = SurfaceOperators::new(mesh);
+    let ops = SurfaceOperators::with_laplacian(mesh, options.laplacian);
     let (original_area, mass) = (ops.total_area(), ops.unit_mass().to_vec());
     let pencil = Pencil::new(ops.laplacian(), &mass)?;
     let n = pencil.n();

@@ -2,7 +2,8 @@
 //! and the smallest eigenpairs of `L φ = λ M φ`.
 //!
 //! Entry points: [`SurfaceOperators`] (a mesh's Laplacian, unit-area mass and cotangent weights,
-//! under one rule), [`laplace_beltrami_spectrum`], [`HeatSmoother`].
+//! under one rule; on the mesh's triangles or, with [`LaplacianKind::IntrinsicDelaunay`], on its
+//! [`IntrinsicDelaunay`] triangulation), [`laplace_beltrami_spectrum`], [`HeatSmoother`].
 //!
 //! Every spectrum coseg computes is that of the mesh **scaled to unit total area**, so that
 //! eigenvalues, diffusion times and energies mean the same on every shape of a collection,
@@ -11,6 +12,7 @@
 mod block_lanczos;
 mod cotan_laplacian;
 mod heat_smoother;
+mod intrinsic_delaunay;
 mod laplace_beltrami_spectrum;
 mod lumped_mass;
 mod shift_invert;
@@ -18,12 +20,13 @@ mod surface_operators;
 
 pub use cotan_laplacian::cotan_laplacian;
 pub use heat_smoother::HeatSmoother;
+pub use intrinsic_delaunay::IntrinsicDelaunay;
 pub use laplace_beltrami_spectrum::{
     SpectrumOptions, SpectrumStats, available_eigenpairs, dense_spectrum,
     laplace_beltrami_spectrum, laplace_beltrami_spectrum_with_stats,
 };
 pub use lumped_mass::lumped_mass;
-pub use surface_operators::{MAX_COTANGENT, SurfaceOperators};
+pub use surface_operators::{LaplacianKind, MAX_COTANGENT, SurfaceOperators};
 
 use thiserror::Error;
 

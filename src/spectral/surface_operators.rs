@@ -12,6 +12,41 @@ use faer::sparse::{SparseColMat, Triplet};
 /// contribute nothing.
 pub const MAX_COTANGENT: f64 = 1e5;
 
+/// Which triangulation the cotangent Laplacian is built on ([`SurfaceOperators::with_laplacian`],
+/// [`super::SpectrumOptions::laplacian`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[non_exhaustive]
+pub enum LaplacianKind {
+    /// The mesh's own triangles (default): the classic cotangent Laplacian.
+    #[default]
+    Cotangent,
+    /// The intrinsic Delaunay triangulation of the mesh ([`super::IntrinsicDelaunay`]): the
+    /// same surface and vertices, edges flipped until every weight is non-negative. Robust to
+    /// obtuse triangles and slivers (CAD exports, uneven sampling); costs one flip pass.
+    IntrinsicDelaunay,
+}
+
+impl LaplacianKind {
+    /// True for the default, [`LaplacianKind::Cotangent`] (lets option structs leave it out of
+    /// their serialised form, so the cache keys of default runs are unchanged).
+    pub fn is_cotangent(&self) -> bool {
+        *self == LaplacianKind::Cotangent
+    }
+}
+
+impl std::str::FromStr for LaplacianKind {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s {
+            "cotan" | "cotangent" => Ok(LaplacianKind::Cotangent),
+            "intrinsic-delaunay" | "idt" => Ok(LaplacianKind::IntrinsicDelaunay),
+            other => Err(format!(
+                "unknown Laplacian {other:?}: expected cotan or intrinsic-delaunay"
+            )),
+        }
+    }
+}
+
 /// The surface operators of one mesh (`d` vertices, `F` faces), computed once and shared by
 /// every algorithm that needs them ([`crate::spectral::laplace_beltrami_spectrum`],
 /// [`crate::spectral::HeatSmoother`], [`crate::features::mean_curvature`]):
@@ -42,6 +77,9 @@ pub const MAX_COTANGENT: f64 = 1e5;
 /// See also [`crate::spectral::cotan_laplacian`], [`crate::spectral::lumped_mass`].
 #[derive(Debug, Clone)]
 pub struct SurfaceOperators {
+    /// The triangles the weights refer to when they are not the mesh's own (intrinsic
+    /// Delaunay); `None`: the mesh's faces.
+    faces: Option<Vec<[u32; 3]>>,
     half_cotangents: Vec<[f64; 3]>,
     laplacian: SparseColMat<usize, f64>,
     vertex_areas: Vec<f64>,
@@ -53,11 +91,12 @@ impl SurfaceOperators {
     /// Computes the operators of `mesh`: O(F) time and memory.
     pub fn new(mesh: &TriMesh) -> Self {
         let half_cotangents = half_cotangents(mesh);
-        let laplacian = assemble(mesh, &half_cotangents);
+        let laplacian = assemble(mesh.vertex_count(), mesh.faces(), &half_cotangents);
         let total_area = mesh.total_area();
         let vertex_areas = mesh.vertex_areas();
         let unit_mass = vertex_areas.iter().map(|m| m / total_area).collect();
         SurfaceOperators {
+            faces: None,
             half_cotangents,
             laplacian,
             vertex_areas,
@@ -66,7 +105,53 @@ impl SurfaceOperators {
         }
     }
 
-    /// `cot(θ_k) / 2` per face corner (`F × 3`), under the rule stated on the type.
+    /// The operators on the triangulation `kind` names: [`LaplacianKind::Cotangent`] is
+    /// [`Self::new`]; [`LaplacianKind::IntrinsicDelaunay`] builds the weights, Laplacian and
+    /// lumped areas on the mesh's intrinsic Delaunay triangulation
+    /// ([`super::IntrinsicDelaunay`]: same vertices and surface, non-negative weights), and
+    /// [`Self::faces`] then returns its triangles. `total_area` is the mesh's either way.
+    ///
+    /// ```
+    /// use coseg::{mesh::TriMesh, spectral::{LaplacianKind, SurfaceOperators}};
+    /// let m = TriMesh::new(
+    ///     vec![[0., 0., 0.], [1., 0.2, 0.], [2., 0., 0.], [1., -0.2, 0.]],
+    ///     vec![[0, 3, 2], [0, 2, 1]],
+    /// ).unwrap();
+    /// let idt = SurfaceOperators::with_laplacian(&m, LaplacianKind::IntrinsicDelaunay);
+    /// assert!(idt.laplacian().triplet_iter().all(|t| t.row == t.col || *t.val <= 0.0));
+    /// assert!((idt.unit_mass().iter().sum::<f64>() - 1.0).abs() < 1e-15);
+    /// ```
+    pub fn with_laplacian(mesh: &TriMesh, kind: LaplacianKind) -> Self {
+        match kind {
+            LaplacianKind::Cotangent => Self::new(mesh),
+            LaplacianKind::IntrinsicDelaunay => {
+                let d = mesh.vertex_count();
+                let idt = super::IntrinsicDelaunay::new(mesh);
+                let half_cotangents = idt.half_cotangents();
+                let laplacian = assemble(d, idt.faces(), &half_cotangents);
+                let total_area = mesh.total_area();
+                let vertex_areas = idt.vertex_areas(d);
+                let unit_mass = vertex_areas.iter().map(|m| m / total_area).collect();
+                SurfaceOperators {
+                    faces: Some(idt.faces().to_vec()),
+                    half_cotangents,
+                    laplacian,
+                    vertex_areas,
+                    unit_mass,
+                    total_area,
+                }
+            }
+        }
+    }
+
+    /// The triangles the weights refer to (`F × 3`): the mesh's own, or the intrinsic
+    /// Delaunay triangulation's under [`LaplacianKind::IntrinsicDelaunay`].
+    pub fn faces<'a>(&'a self, mesh: &'a TriMesh) -> &'a [[u32; 3]] {
+        self.faces.as_deref().unwrap_or(mesh.faces())
+    }
+
+    /// `cot(θ_k) / 2` per face corner (`F × 3`, corners of [`Self::faces`]), under the rule
+    /// stated on the type.
     pub fn half_cotangents(&self) -> &[[f64; 3]] {
         &self.half_cotangents
     }
@@ -102,7 +187,7 @@ impl SurfaceOperators {
     /// x_j)`. `mesh` must be the mesh the operators were built from.
     pub fn laplacian_times(&self, mesh: &TriMesh, x: &[[f64; 3]]) -> Vec<[f64; 3]> {
         let mut lx = vec![[0.0f64; 3]; x.len()];
-        for (idx, w) in mesh.faces().iter().zip(&self.half_cotangents) {
+        for (idx, w) in self.faces(mesh).iter().zip(&self.half_cotangents) {
             for (k, &wk) in w.iter().enumerate() {
                 if wk == 0.0 {
                     continue;
@@ -121,7 +206,7 @@ impl SurfaceOperators {
 
 /// The cotangent Laplacian alone (see [`super::cotan_laplacian`]).
 pub(super) fn laplacian(mesh: &TriMesh) -> SparseColMat<usize, f64> {
-    assemble(mesh, &half_cotangents(mesh))
+    assemble(mesh.vertex_count(), mesh.faces(), &half_cotangents(mesh))
 }
 
 /// The per-corner half-cotangents of every face under the rule of [`SurfaceOperators`].
@@ -154,10 +239,15 @@ fn half_cotangents(mesh: &TriMesh) -> Vec<[f64; 3]> {
         .collect()
 }
 
-fn assemble(mesh: &TriMesh, half_cotangents: &[[f64; 3]]) -> SparseColMat<usize, f64> {
-    let d = mesh.vertex_count();
-    let mut triplets = Vec::with_capacity(mesh.face_count() * 12);
-    for (idx, w) in mesh.faces().iter().zip(half_cotangents) {
+/// The `d × d` Laplacian of `faces` with per-corner weights `half_cotangents` (weight of the
+/// edge facing the corner).
+pub(super) fn assemble(
+    d: usize,
+    faces: &[[u32; 3]],
+    half_cotangents: &[[f64; 3]],
+) -> SparseColMat<usize, f64> {
+    let mut triplets = Vec::with_capacity(faces.len() * 12);
+    for (idx, w) in faces.iter().zip(half_cotangents) {
         if *w == [0.0; 3] {
             continue;
         }
