@@ -1,6 +1,9 @@
 //! Per-shape cost of each feature family on the meshes given on the command line:
-//! spectral (spectrum + descriptors), extrinsic (100 directions, PCA frame), sdf (30 rays).
-//! Median of `--reps` runs (default 3) for the extrinsic and sdf families, one for the spectrum.
+//! spectral (spectrum + descriptors), extrinsic (100 directions, PCA frame), sdf (30 rays), and
+//! the spectral family's intrinsic Delaunay option (the flips and operators alone, with the
+//! number of flips, and the whole spectrum on it).
+//! Median of `--reps` runs (default 3) for the extrinsic, sdf and flip columns, one for the
+//! spectra.
 //!
 //!     cargo run --release --example bench_families -- MESH... [--reps N]
 
@@ -9,7 +12,9 @@ use coseg::features::{
     shape_diameter,
 };
 use coseg::mesh::read_mesh;
-use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
+use coseg::spectral::{
+    LaplacianKind, SpectrumOptions, SurfaceOperators, laplace_beltrami_spectrum,
+};
 use std::time::Instant;
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -30,8 +35,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         .filter(|(i, a)| !a.starts_with("--") && (*i == 0 || args[i - 1] != "--reps"))
         .map(|(_, a)| a)
         .collect();
-    println!("| mesh | vertices | spectrum (s) | descriptors (s) | extrinsic (s) | sdf (s) |");
-    println!("|---|---|---|---|---|---|");
+    println!(
+        "| mesh | vertices | spectrum (s) | descriptors (s) | extrinsic (s) | sdf (s) | intrinsic Delaunay operators (s) | flips | spectrum on it (s) |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
     for path in meshes {
         let m = read_mesh(path)?;
         let t = Instant::now();
@@ -58,8 +65,23 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 })
                 .collect::<Result<_, _>>()?,
         );
+        let idt = median(
+            (0..reps)
+                .map(|_| {
+                    let t = Instant::now();
+                    SurfaceOperators::with_laplacian(&m, LaplacianKind::IntrinsicDelaunay);
+                    t.elapsed().as_secs_f64()
+                })
+                .collect(),
+        );
+        let flips = coseg::spectral::IntrinsicDelaunay::new(&m).flips();
+        let mut so = SpectrumOptions::default();
+        so.laplacian = LaplacianKind::IntrinsicDelaunay;
+        let t = Instant::now();
+        laplace_beltrami_spectrum(&m, &so)?;
+        let spectrum_idt = t.elapsed().as_secs_f64();
         println!(
-            "| {path} | {} | {spectrum:.2} | {desc:.2} | {ext:.3} | {sdf:.2} |",
+            "| {path} | {} | {spectrum:.2} | {desc:.2} | {ext:.3} | {sdf:.2} | {idt:.3} | {flips} | {spectrum_idt:.2} |",
             m.vertex_count()
         );
     }
