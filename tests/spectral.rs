@@ -1014,7 +1014,7 @@ mod intrinsic_delaunay {
             for j in 0..n {
                 for i in 0..n {
                     let (a, b, c, d) = (id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1));
-                    if (i * 7 + j * 13 + seed as usize) % 3 == 0 {
+                    if (i * 7 + j * 13 + seed as usize).is_multiple_of(3) {
                         faces.extend([[a, b, c], [a, c, d]]);
                     } else {
                         faces.extend([[a, b, d], [b, c, d]]);
