@@ -40,8 +40,8 @@ pub struct PipelineArgs {
     #[arg(long, default_value_t = 0)]
     normals: usize,
     /// Family weights in the affinity, e.g. spectral=1,extrinsic=2 (a family's total share;
-    /// default 1 each). Used by `coseg segment` and `coseg propagate`; `coseg pair` weights every
-    /// column equally.
+    /// default 1 each). Used by `coseg segment`, `coseg propagate` and `coseg pair` (all its
+    /// stages).
     #[arg(long, default_value = "")]
     family_weights: String,
 }
