@@ -2,7 +2,7 @@
 
 use clap::Args;
 use coseg::bands::BandWeighting;
-use coseg::features::{ExtrinsicOptions, parse_alignment, parse_families, parse_family_weights};
+use coseg::features::ExtrinsicOptions;
 use coseg::pipeline::ShapePipelineOptions;
 
 #[derive(Debug, Args)]
@@ -50,13 +50,6 @@ impl PipelineArgs {
     /// The library options these flags select (library defaults for everything else).
     pub fn options(&self) -> anyhow::Result<ShapePipelineOptions> {
         let mut opts = ShapePipelineOptions::default();
-        let (spectral, mut families) = parse_families(&self.features, parse_alignment(&self.up)?)?;
-        if let Some(e) = families.extrinsic.as_mut() {
-            e.directions = self.directions;
-            e.normal_directions = self.normals;
-        }
-        parse_family_weights(&self.family_weights, &mut families.weights)?;
-        opts.families = families;
         opts.spectrum.eigenpairs = self.eigenpairs;
         opts.descriptors.hks_count = self.hks;
         opts.descriptors.wks_count = self.wks;
@@ -65,11 +58,13 @@ impl PipelineArgs {
         if self.area_bands {
             opts.bands.weighting = BandWeighting::Area;
         }
-        if !spectral {
-            opts.descriptors.hks_count = 0;
-            opts.descriptors.wks_count = 0;
-            opts.descriptors.curvature_count = 0;
-        }
+        opts.set_families(
+            &self.features,
+            &self.up,
+            self.directions,
+            self.normals,
+            &self.family_weights,
+        )?;
         Ok(opts)
     }
 }
