@@ -4,11 +4,17 @@
 //! cargo run --release --example eval_tosca -- /work/shared/data/tosca [--cache DIR]
 //!     [--shapes 4] [--seed 0] [--map-weight β] [--nearest] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
 //!     [--area-bands] [--eigenpairs k] [--hks n] [--wks n] [--curvature n]
+//!     [--features LIST] [--up AXIS|pca] [--directions N] [--normals N] [--family-weights W]
 //! ```
 //! For every class, the first `--shapes` files `<class><i>.off` in increasing `i` are taken and
 //! every unordered pair is segmented; the table gives the mean ratio per class and overall for
 //! each configuration (Algorithm 2 at a 10 % area cutoff, Algorithm 3), plus the time spent in
 //! the stable-region algorithm (per-shape data are cached and excluded).
+//!
+//! `--features`, `--up`, `--directions`, `--normals`, `--family-weights` are `coseg pair`'s
+//! flags (docs/FEATURES.md), translated by the same library call
+//! (`ShapePipelineOptions::set_families`); every configuration then runs on the affinity
+//! weighted by the families' shares (`stable::pair_affinity`), as `coseg pair` does.
 //!
 //! `--nearest` reads the map step's last point map by nearest neighbours (ZoomOut as
 //! published) instead of the default one-to-one assignment.
@@ -17,8 +23,8 @@
 //! map by ZoomOut started from the ground truth, to measure what a perfect start of the map
 //! would buy.
 
-use coseg::affinity::BandAffinity;
 use coseg::bands::BandWeighting;
+use coseg::features::ExtrinsicOptions;
 use coseg::maps::MapGuidedOptions;
 use coseg::maps::{FinalMatch, ZoomOutOptions, zoomout};
 use coseg::maps::{MapPreset, MapStep, ShapeGeometry};
@@ -27,8 +33,8 @@ use coseg::pipeline::{ShapeData, ShapePipelineOptions, load_or_compute};
 use coseg::spectral::HeatSmoother;
 use coseg::stable::{
     Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions,
-    StableRegionsOptions, TSearch, VertexMap, correspondence_stats, point_map_refinement,
-    refine_regions, segment_pair, stable_regions,
+    StableRegionsOptions, TSearch, VertexMap, correspondence_stats, pair_affinity,
+    point_map_refinement, refine_regions, segment_pair, stable_regions_with,
 };
 use std::path::PathBuf;
 use std::time::Instant;
@@ -253,6 +259,10 @@ fn main() -> anyhow::Result<()> {
     ];
     let mut which = "all".to_string();
     let mut pipe = ShapePipelineOptions::default();
+    // `coseg pair`'s family flags and their defaults.
+    let (mut features, mut up, mut family_weights) =
+        ("spectral".to_string(), "y".to_string(), String::new());
+    let (mut directions, mut normals) = (ExtrinsicOptions::default().directions, 0usize);
     let mut i = 0;
     while i < args.len() {
         let next = |i: usize| args.get(i + 1).cloned().unwrap_or_default();
@@ -303,10 +313,31 @@ fn main() -> anyhow::Result<()> {
                 i += 1;
             }
             "--area-bands" => pipe.bands.weighting = BandWeighting::Area,
+            "--features" => {
+                features = next(i);
+                i += 1;
+            }
+            "--up" => {
+                up = next(i);
+                i += 1;
+            }
+            "--directions" => {
+                directions = next(i).parse()?;
+                i += 1;
+            }
+            "--normals" => {
+                normals = next(i).parse()?;
+                i += 1;
+            }
+            "--family-weights" => {
+                family_weights = next(i);
+                i += 1;
+            }
             d => dir = Some(PathBuf::from(d)),
         }
         i += 1;
     }
+    pipe.set_families(&features, &up, directions, normals, &family_weights)?;
     let dir = dir.ok_or_else(|| anyhow::anyhow!("usage: eval_tosca DATA_DIR [options]"))?;
     let configs: Vec<_> = configs()
         .into_iter()
@@ -371,11 +402,14 @@ fn main() -> anyhow::Result<()> {
                 for (k, (_, opts, post)) in configs.iter().enumerate() {
                     let t = Instant::now();
                     let (ba, bb) = (&sa.data.bands, &sb.data.bands);
-                    let w = BandAffinity::new(ba, bb)?;
+                    // The families' shares, as `coseg pair` weighs them (`None`: one family).
+                    let weights = pipe.feature_weights(ba.features);
+                    let w = pair_affinity(ba, bb, weights.as_deref())?;
+                    let stable = || stable_regions_with(&w, &sa.areas, &sb.areas, opts);
                     let refined = || -> anyhow::Result<_> {
                         Ok(refine_regions(
                             &w,
-                            &stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
+                            &stable()?,
                             &sa.areas,
                             &sb.areas,
                             Some(&sa.refine_smoother),
@@ -392,12 +426,13 @@ fn main() -> anyhow::Result<()> {
                             let mut o2 = SegmentPairOptions::default();
                             o2.regions = opts.clone();
                             o2.map_step = MapStep::Options(map_guided);
+                            o2.feature_weights = weights.clone();
                             o2
                         };
                         Ok(segment_pair(sa.pair_shape(), sb.pair_shape(), &options)?.regions)
                     };
                     let r = match post {
-                        Post::None => stable_regions(ba, bb, &sa.areas, &sb.areas, opts)?,
+                        Post::None => stable()?,
                         Post::Refine => refined()?,
                         Post::RefineMap => whole_stage(map_step.clone())?,
                         Post::RefineMapIsometric => {

@@ -246,6 +246,54 @@ fn render_writes_a_png_of_the_expected_size_that_is_not_one_colour() {
     );
 }
 
+/// `coseg pair --family-weights` reaches the pair's affinity: with two families, the extrinsic
+/// family weighed far above or far below the spectral one gives other regions (were the
+/// weights ignored, the two runs would write the same files); scaling every weight alike
+/// changes nothing.
+#[test]
+fn pair_weighs_the_feature_families() {
+    let dir = tempfile::tempdir().unwrap();
+    shapes(dir.path(), 2, 2);
+    let regions = |weights: &str| {
+        let out = dir.path().join(format!("pair-{weights}"));
+        let run = coseg(&[
+            "-q",
+            "pair",
+            s(&dir.path().join("s0.obj")),
+            s(&dir.path().join("s1.off")),
+            "-o",
+            s(&out),
+            "--no-pictures",
+            "--eigenpairs",
+            "20",
+            "--hks",
+            "6",
+            "--wks",
+            "6",
+            "--curvature",
+            "6",
+            "--bands",
+            "6",
+            "--pairs",
+            "4",
+            "--features",
+            "spectral,extrinsic",
+            "--up",
+            "pca",
+            "--directions",
+            "12",
+            "--family-weights",
+            weights,
+        ]);
+        assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+        std::fs::read(out.join("s0.regions.txt")).unwrap()
+    };
+    let spectral_led = regions("extrinsic=0.0625");
+    assert_ne!(spectral_led, regions("extrinsic=16"));
+    // Only the shares count (powers of two, so that the normalised weights are exactly equal).
+    assert_eq!(spectral_led, regions("spectral=16"));
+}
+
 fn cache_entries(dir: &Path) -> Vec<PathBuf> {
     let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
         .map(|r| {

@@ -816,8 +816,9 @@ mod map_guided {
     use coseg::spectral::HeatSmoother;
     use coseg::stable::{
         PairShape, RefineOptions, RegionPair, SegmentPairOptions, StableRegions,
-        StableRegionsOptions, Threshold, assign_regions, map_guided_refinement,
+        StableRegionsOptions, Threshold, assign_regions, map_guided_refinement, pair_affinity,
         point_map_refinement, refine_regions, region_scores, segment_pair, stable_regions,
+        stable_regions_with,
     };
 
     fn small_pipeline() -> ShapePipelineOptions {
@@ -1145,6 +1146,128 @@ mod map_guided {
         let other = blob(2);
         let mismatched = PairShape { mesh: &other, ..sb };
         assert!(segment_pair(sa, mismatched, &options).is_err());
+    }
+
+    /// A blob and a permuted copy with spectral and extrinsic (PCA) columns, and the families'
+    /// per-column weights with the extrinsic family's share 50 times the spectral one's.
+    fn family_pair() -> (TriMesh, TriMesh, ShapeData, ShapeData, Vec<f64>) {
+        use coseg::features::{Alignment, parse_families};
+        let a = blob(3);
+        let b = permute_mesh(&a, &permutation(a.vertex_count(), 5));
+        let mut pipe = small_pipeline();
+        pipe.families = parse_families("spectral,extrinsic", Alignment::Pca)
+            .unwrap()
+            .1;
+        pipe.families.extrinsic.as_mut().unwrap().directions = 8;
+        pipe.families.weights.extrinsic = 50.0;
+        let (da, db) = (
+            compute_shape_data(&a, &pipe).unwrap(),
+            compute_shape_data(&b, &pipe).unwrap(),
+        );
+        let weights = pipe.feature_weights(da.bands.features).unwrap();
+        (a, b, da, db, weights)
+    }
+
+    /// Six pairs at 1/6 of the area, default refinement, the map step with the test's small
+    /// point-map options.
+    fn six_pairs() -> SegmentPairOptions {
+        let mut o2 = SegmentPairOptions::default();
+        o2.regions = {
+            let mut opts = StableRegionsOptions::default();
+            opts.pairs = 6;
+            opts.p = Threshold::AreaFraction(1.0 / 6.0);
+            opts.q = Threshold::AreaFraction(1.0 / 6.0);
+            opts
+        };
+        o2.refine = Some(RefineOptions::default());
+        o2.map_step = MapStep::Options({
+            let mut opts = MapGuidedOptions::default();
+            opts.point_map = options();
+            opts
+        });
+        o2
+    }
+
+    /// `feature_weights` reach every stage: `segment_pair` equals its three stages run by hand
+    /// on the weighted operator (`pair_affinity`), and each stage on the equal-weight operator
+    /// would give other regions, so ignoring the weights anywhere fails this test.
+    #[test]
+    fn segment_pair_runs_every_stage_on_the_family_weighted_affinity() {
+        let (a, b, da, db, weights) = family_pair();
+        let (sa, sb) = (pair_shape(&a, &da), pair_shape(&b, &db));
+        let mut options = six_pairs();
+        options.feature_weights = Some(weights.clone());
+        let out = segment_pair(sa, sb, &options).unwrap();
+
+        let (areas_a, areas_b) = (a.vertex_areas(), b.vertex_areas());
+        let w = pair_affinity(&da.bands, &db.bands, Some(&weights)).unwrap();
+        let equal = BandAffinity::new(&da.bands, &db.bands).unwrap();
+        assert_ne!(w.weights(), equal.weights());
+        let raw = stable_regions_with(&w, &areas_a, &areas_b, &options.regions).unwrap();
+        let refine = options.refine.as_ref().unwrap();
+        let smoother = |m: &TriMesh, t: f64| HeatSmoother::new(m, t).unwrap();
+        let (ra, rb) = (
+            smoother(&a, refine.smoothing_time),
+            smoother(&b, refine.smoothing_time),
+        );
+        let refine_on = |w: &BandAffinity<'_>, r: &StableRegions| {
+            refine_regions(w, r, &areas_a, &areas_b, Some(&ra), Some(&rb), refine).unwrap()
+        };
+        let refined = refine_on(&w, &raw);
+        let map_guided = out.map_guided.as_ref().unwrap();
+        let mb = smoother(&b, map_guided.smoothing_time);
+        let map_on = |w: &BandAffinity<'_>, r: &StableRegions| {
+            map_guided_refinement(
+                w,
+                r,
+                geometry(&a, &da),
+                geometry(&b, &db),
+                Some(&mb),
+                map_guided,
+            )
+            .unwrap()
+        };
+        let by_hand = map_on(&w, &refined);
+        assert_eq!(out.regions, by_hand);
+
+        // Every stage tells the weighted operator from the equal-weight one.
+        let unweighted_raw =
+            stable_regions(&da.bands, &db.bands, &areas_a, &areas_b, &options.regions).unwrap();
+        assert_ne!(raw.labels_a(), unweighted_raw.labels_a());
+        assert_ne!(refine_on(&equal, &raw), refined);
+        assert_ne!(map_on(&equal, &refined), by_hand);
+        let mut bare = options.clone();
+        bare.refine = None;
+        bare.map_step = MapStep::Off;
+        assert_eq!(segment_pair(sa, sb, &bare).unwrap().regions, raw);
+        options.feature_weights = None;
+        assert_ne!(segment_pair(sa, sb, &options).unwrap().regions, out.regions);
+
+        // Weights must be one per column, finite, non-negative, not all zero.
+        for bad in [
+            vec![1.0; 3],
+            vec![f64::NAN; weights.len()],
+            vec![0.0; weights.len()],
+        ] {
+            options.feature_weights = Some(bad);
+            assert!(segment_pair(sa, sb, &options).is_err());
+        }
+    }
+
+    /// The default is unchanged: one family gives no weights (`None`), and equal weights of any
+    /// value give the equal-weight result bit for bit, with or without a second family.
+    #[test]
+    fn equal_feature_weights_leave_segment_pair_unchanged() {
+        let (a, b, _, da, db) = permuted_pair();
+        assert_eq!(small_pipeline().feature_weights(da.bands.features), None);
+        let (fa, fb, fda, fdb, _) = family_pair();
+        for (a, b, da, db) in [(&a, &b, &da, &db), (&fa, &fb, &fda, &fdb)] {
+            let (sa, sb) = (pair_shape(a, da), pair_shape(b, db));
+            let mut options = six_pairs();
+            let default = segment_pair(sa, sb, &options).unwrap().regions;
+            options.feature_weights = Some(vec![0.37; da.bands.features]);
+            assert_eq!(segment_pair(sa, sb, &options).unwrap().regions, default);
+        }
     }
 }
 

@@ -241,7 +241,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
             .unwrap_or_else(|| args.output.join(".cache"))
     });
     let loaded = load_pair(&args, &pipe, cache.as_deref())?;
-    let pair_options = segment_pair_options(&args);
+    let pair_options = segment_pair_options(&args, &pipe, loaded[0].1.bands.features);
     let (ma, mb) = (&loaded[0].0, &loaded[1].0);
     let t = Instant::now();
     let pair = segment_loaded(&args, &loaded, &pair_options)?;
@@ -302,9 +302,16 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
 }
 
 /// The whole pair stage's options the flags select: the flag-to-option translation kept in one
-/// place, out of `run`, next to [`region_options`] and [`map_step`] which it combines.
-fn segment_pair_options(args: &PairArgs) -> SegmentPairOptions {
+/// place, out of `run`, next to [`region_options`] and [`map_step`] which it combines; the
+/// affinity's per-feature weights are the families' shares (`--family-weights`) over a table of
+/// `features` columns, as `coseg segment` and `coseg propagate` use them.
+fn segment_pair_options(
+    args: &PairArgs,
+    pipe: &ShapePipelineOptions,
+    features: usize,
+) -> SegmentPairOptions {
     let mut opts = SegmentPairOptions::default();
+    opts.feature_weights = pipe.feature_weights(features);
     opts.regions = region_options(args);
     opts.refine = (args.refine_rounds > 0).then(|| {
         let mut refine = RefineOptions::default();

@@ -2,7 +2,7 @@
 
 use clap::Args;
 use coseg::bands::BandWeighting;
-use coseg::features::{ExtrinsicOptions, parse_alignment, parse_families, parse_family_weights};
+use coseg::features::ExtrinsicOptions;
 use coseg::pipeline::ShapePipelineOptions;
 
 #[derive(Debug, Args)]
@@ -45,8 +45,8 @@ pub struct PipelineArgs {
     #[arg(long, default_value = "cotan")]
     laplacian: String,
     /// Family weights in the affinity, e.g. spectral=1,extrinsic=2 (a family's total share;
-    /// default 1 each). Used by `coseg segment` and `coseg propagate`; `coseg pair` weights every
-    /// column equally.
+    /// default 1 each). Used by `coseg segment`, `coseg propagate` and `coseg pair` (all its
+    /// stages).
     #[arg(long, default_value = "")]
     family_weights: String,
 }
@@ -55,13 +55,6 @@ impl PipelineArgs {
     /// The library options these flags select (library defaults for everything else).
     pub fn options(&self) -> anyhow::Result<ShapePipelineOptions> {
         let mut opts = ShapePipelineOptions::default();
-        let (spectral, mut families) = parse_families(&self.features, parse_alignment(&self.up)?)?;
-        if let Some(e) = families.extrinsic.as_mut() {
-            e.directions = self.directions;
-            e.normal_directions = self.normals;
-        }
-        parse_family_weights(&self.family_weights, &mut families.weights)?;
-        opts.families = families;
         opts.spectrum.eigenpairs = self.eigenpairs;
         opts.spectrum.laplacian = self.laplacian.parse().map_err(anyhow::Error::msg)?;
         opts.descriptors.hks_count = self.hks;
@@ -71,11 +64,13 @@ impl PipelineArgs {
         if self.area_bands {
             opts.bands.weighting = BandWeighting::Area;
         }
-        if !spectral {
-            opts.descriptors.hks_count = 0;
-            opts.descriptors.wks_count = 0;
-            opts.descriptors.curvature_count = 0;
-        }
+        opts.set_families(
+            &self.features,
+            &self.up,
+            self.directions,
+            self.normals,
+            &self.family_weights,
+        )?;
         Ok(opts)
     }
 }

@@ -3,7 +3,10 @@
 
 use crate::bands::{BandError, BandOptions, BandTable, band_table};
 use crate::cache::{EntryKind, ShapeKey, decode_entry, encode_entry, entry_key};
-use crate::features::{DescriptorOptions, Descriptors, FeatureError, FeatureFamilies, descriptors};
+use crate::features::{
+    DescriptorOptions, Descriptors, FeatureError, FeatureFamilies, descriptors, parse_alignment,
+    parse_families, parse_family_weights,
+};
 use crate::mesh::{MeshError, TriMesh};
 use crate::spectral::{
     SpectralError, Spectrum, SpectrumOptions, available_eigenpairs, laplace_beltrami_spectrum,
@@ -51,6 +54,49 @@ pub struct ShapePipelineOptions {
 }
 
 impl ShapePipelineOptions {
+    /// Sets the feature families from their text form, as `coseg`'s flags state them:
+    /// `features` = `--features` (`spectral,extrinsic,sdf,user:DIR`,
+    /// [`parse_families`](crate::features::parse_families)), `up` = `--up` (`y`, `-z`, `pca`,
+    /// [`parse_alignment`](crate::features::parse_alignment)), `directions` and `normals` = the
+    /// extrinsic family's `--directions` and `--normals` (unused without it), `weights` =
+    /// `--family-weights` (`extrinsic=2,sdf=0.5`; empty: 1 each,
+    /// [`parse_family_weights`](crate::features::parse_family_weights)). Without the spectral
+    /// family the spectral descriptor counts become 0; with it they are left as they are. The
+    /// one translation of these flags (the CLI and the examples call it).
+    ///
+    /// ```
+    /// use coseg::pipeline::ShapePipelineOptions;
+    /// let mut o = ShapePipelineOptions::default();
+    /// o.set_families("spectral", "y", 100, 0, "").unwrap();
+    /// assert_eq!(o, ShapePipelineOptions::default());
+    /// o.set_families("extrinsic", "pca", 10, 4, "extrinsic=2").unwrap();
+    /// assert_eq!(o.descriptors.hks_count, 0);
+    /// assert_eq!(o.families.extrinsic.as_ref().unwrap().normal_directions, 4);
+    /// assert!(o.set_families("spectral,colour", "y", 100, 0, "").is_err());
+    /// ```
+    pub fn set_families(
+        &mut self,
+        features: &str,
+        up: &str,
+        directions: usize,
+        normals: usize,
+        weights: &str,
+    ) -> Result<(), FeatureError> {
+        let (spectral, mut families) = parse_families(features, parse_alignment(up)?)?;
+        if let Some(e) = families.extrinsic.as_mut() {
+            e.directions = directions;
+            e.normal_directions = normals;
+        }
+        parse_family_weights(weights, &mut families.weights)?;
+        self.families = families;
+        if !spectral {
+            self.descriptors.hks_count = 0;
+            self.descriptors.wks_count = 0;
+            self.descriptors.curvature_count = 0;
+        }
+        Ok(())
+    }
+
     /// Per-column affinity weights for a feature table of `features` columns made under these
     /// options ([`FeatureFamilies::feature_weights`]; the user family's count is what remains
     /// after the others). `None`: one family, equal weights.

@@ -5,7 +5,8 @@
 //! - [`stable_pair`]: Algorithm 1 (stable pair from an initial indicator).
 //! - [`stable_pairs_fixed`]: Algorithm 2 (fixed thresholds).
 //! - [`stable_pairs_auto`]: Algorithm 3 (automatic thresholds).
-//! - [`stable_regions`]: one call from two band tables.
+//! - [`stable_regions`]: one call from two band tables ([`stable_regions_with`]: on an affinity
+//!   already built, e.g. [`pair_affinity`] with per-feature weights).
 //! - [`refine_partition`]: smoothed best-response refinement of two corresponding partitions.
 //! - [`refine_regions`]: the same on the output of Algorithms 2 and 3.
 //! - [`region_point_map`](crate::maps::region_point_map): a vertex map from corresponding regions (functional map + ZoomOut), in [`crate::maps`].
@@ -49,7 +50,7 @@ pub use stable_pair::{
 };
 pub use stable_pairs_auto::stable_pairs_auto;
 pub use stable_pairs_fixed::stable_pairs_fixed;
-pub use stable_regions::stable_regions;
+pub use stable_regions::{pair_affinity, stable_regions, stable_regions_with};
 pub use threshold::{Threshold, ThresholdScratch, threshold};
 
 use crate::affinity::AffinityError;

@@ -1,9 +1,11 @@
-//! [`segment_pair`]: the whole pair stage in one call ([`stable_regions`] →
-//! [`refine_regions`] → [`map_guided_refinement`]), as `coseg pair` runs it.
+//! [`segment_pair`]: the whole pair stage in one call (Algorithm 2 or 3 →
+//! [`refine_regions`] → [`map_guided_refinement`], all on one affinity), as `coseg pair` runs
+//! it.
 
+use super::stable_regions::{pair_affinity, stable_regions_with};
 use super::{
     RefineOptions, StableError, StableRegions, StableRegionsOptions, map_guided_refinement,
-    refine_regions, stable_regions,
+    refine_regions,
 };
 use crate::affinity::BandAffinity;
 use crate::bands::BandTable;
@@ -31,6 +33,13 @@ pub struct SegmentPairOptions {
     /// resolved for the pair ([`MapStep::resolve`]); [`MapStep::Off`] skips it (default:
     /// [`MapStep::Auto`]).
     pub map_step: MapStep,
+    /// Weight of each feature (column of the band tables) in the affinity of every stage, as
+    /// [`pair_affinity`](super::pair_affinity) takes them; `None` = equal weights (default).
+    /// `coseg pair` sets the feature families' shares,
+    /// [`ShapePipelineOptions::feature_weights`](crate::pipeline::ShapePipelineOptions::feature_weights),
+    /// as `coseg segment` and `coseg propagate` do: `None` when the table has one family.
+    #[serde(default)]
+    pub feature_weights: Option<Vec<f64>>,
 }
 
 impl Default for SegmentPairOptions {
@@ -39,6 +48,7 @@ impl Default for SegmentPairOptions {
             regions: StableRegionsOptions::default(),
             refine: Some(RefineOptions::default()),
             map_step: MapStep::default(),
+            feature_weights: None,
         }
     }
 }
@@ -71,7 +81,8 @@ impl<'a> PairShape<'a> {
 /// Wall time of each stage of [`segment_pair`].
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct PairTimes {
-    /// [`stable_regions`].
+    /// Building the affinity ([`pair_affinity`]) and
+    /// [`stable_regions_with`](super::stable_regions_with).
     pub algorithm: Duration,
     /// Factorising the heat smoothers.
     pub smoothers: Duration,
@@ -99,9 +110,11 @@ pub struct SegmentedPair {
     pub map_preset: Option<PresetChoice>,
 }
 
-/// Stable region correspondences between two shapes: Algorithm 2 or 3 ([`stable_regions`]),
-/// then (by default) [`refine_regions`] and [`map_guided_refinement`], with heat smoothers
-/// built on the meshes at the stages' smoothing times.
+/// Stable region correspondences between two shapes: Algorithm 2 or 3
+/// ([`stable_regions_with`](super::stable_regions_with)), then (by default) [`refine_regions`]
+/// and [`map_guided_refinement`], with heat smoothers built on the meshes at the stages'
+/// smoothing times. Every stage runs on one affinity, [`pair_affinity`] with
+/// [`SegmentPairOptions::feature_weights`] (equal weights by default).
 ///
 /// The two later stages are optional: one that cannot run on these shapes (a smoother that
 /// cannot be factored, a map that cannot be fitted) leaves the previous stage's regions and is
@@ -137,7 +150,10 @@ pub fn segment_pair(
     let mut fallbacks = Vec::new();
     let (areas_a, areas_b) = (a.mesh.vertex_areas(), b.mesh.vertex_areas());
     let t = Instant::now();
-    let mut regions = stable_regions(a.bands, b.bands, &areas_a, &areas_b, &options.regions)?;
+    // One operator for every stage: the algorithm, the refinement and the map step all weigh
+    // the features alike.
+    let w = pair_affinity(a.bands, b.bands, options.feature_weights.as_deref())?;
+    let mut regions = stable_regions_with(&w, &areas_a, &areas_b, &options.regions)?;
     times.algorithm = t.elapsed();
     let refine = options.refine.as_ref().filter(|r| r.max_rounds > 0);
     let map_guided = map_guided_options.as_ref();
@@ -150,27 +166,6 @@ pub fn segment_pair(
             map_preset,
         });
     }
-    let w = match BandAffinity::new(a.bands, b.bands) {
-        Ok(w) => w,
-        Err(e) => {
-            let reason = e.to_string();
-            for (stage, on) in [
-                (PairStage::Refine, refine.is_some()),
-                (PairStage::MapGuided, map_guided.is_some()),
-            ] {
-                if on {
-                    fallbacks.push(StageFallback::new(stage, &reason));
-                }
-            }
-            return Ok(SegmentedPair {
-                regions,
-                times,
-                fallbacks,
-                map_guided: map_guided_options,
-                map_preset,
-            });
-        }
-    };
     if let Some(refine) = refine {
         let areas = (&areas_a[..], &areas_b[..]);
         match refine_stage(&w, &regions, a, b, areas, refine, &mut times) {
