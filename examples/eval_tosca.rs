@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release --example eval_tosca -- /work/shared/data/tosca [--cache DIR]
 //!     [--shapes 4] [--seed 0] [--map-weight β] [--nearest] [--classes cat,dog,horse,david] [--configs all|NAME,NAME] [--bands K]
-//!     [--area-bands] [--eigenpairs k] [--hks n] [--wks n] [--curvature n]
+//!     [--area-bands] [--eigenpairs k] [--laplacian cotan|intrinsic-delaunay] [--hks n] [--wks n] [--curvature n]
 //!     [--features LIST] [--up AXIS|pca] [--directions N] [--normals N] [--family-weights W]
 //! ```
 //! For every class, the first `--shapes` files `<class><i>.off` in increasing `i` are taken and
@@ -298,6 +298,10 @@ fn main() -> anyhow::Result<()> {
             }
             "--eigenpairs" => {
                 pipe.spectrum.eigenpairs = next(i).parse()?;
+                i += 1;
+            }
+            "--laplacian" => {
+                pipe.spectrum.laplacian = next(i).parse().map_err(anyhow::Error::msg)?;
                 i += 1;
             }
             "--hks" => {
