@@ -414,7 +414,9 @@ fn pair<'py>(
                 data.push(d);
             }
             let (da, db) = (&data[0], &data[1]);
-            let options = pair_opts.options();
+            let mut options = pair_opts.options();
+            // As `coseg pair`: the families' weights over the table's columns.
+            options.feature_weights = pipe.feature_weights(da.bands.features);
             let t = std::time::Instant::now();
             let pair = segment_pair(
                 PairShape {
