@@ -645,3 +645,73 @@ fn segment_collection_is_cosegment_then_refinement() {
     assert!(out.segmentation != raw, "the refinement changed nothing");
     assert!(segment_collection(nodes_from(&tables, &areas), &meshes[..3], &opts).is_err());
 }
+
+/// `starts`: every start is the co-segmentation (and refinement) of its own seed, the kept one
+/// has the highest score (ties: the earliest), and one start is the plain run.
+#[test]
+fn segment_collection_keeps_the_start_of_highest_confidence() {
+    use coseg::graph::{SegmentCollectionOptions, segment_collection, start_score};
+    use coseg::stable::RefineOptions;
+    let mesh = common::shapes::icosphere(2, 1.0);
+    let d = mesh.vertex_count();
+    let (tables, areas) = noisy_collection(4, d, 5);
+    let meshes = vec![mesh; 4];
+    let mut opts = SegmentCollectionOptions::default();
+    opts.cosegment.regions = 4;
+    opts.refine = Some({
+        let mut r = RefineOptions::default();
+        r.max_rounds = 3;
+        r.smoothing_time = 0.01;
+        r
+    });
+    let run = |starts: usize, seed: Option<u64>| {
+        let mut o = opts.clone();
+        o.starts = starts;
+        o.cosegment.seed = seed;
+        segment_collection(nodes_from(&tables, &areas), &meshes, &o).unwrap()
+    };
+    let one = run(1, None);
+    assert_eq!((one.start, one.start_scores.len()), (0, 1));
+    assert_eq!(one.start_scores[0], start_score(&one.segmentation));
+    let many = run(5, None);
+    assert_eq!(many.start_scores.len(), 5);
+    // The starts differ here, so the choice is tested.
+    assert!(
+        many.start_scores.iter().any(|&x| x != many.start_scores[0]),
+        "{:?}",
+        many.start_scores
+    );
+    // Start s is the run seeded with s (start 0 the unseeded one), bit for bit.
+    let singles: Vec<_> = (0..5)
+        .map(|s| run(1, (s > 0).then_some(s as u64)))
+        .collect();
+    for (s, single) in singles.iter().enumerate() {
+        assert_eq!(
+            many.start_scores[s],
+            start_score(&single.segmentation),
+            "start {s}"
+        );
+    }
+    let best = many
+        .start_scores
+        .iter()
+        .enumerate()
+        .fold(0, |b, (i, &x)| if x > many.start_scores[b] { i } else { b });
+    assert_eq!(many.start, best);
+    assert_eq!(many.segmentation, singles[best].segmentation);
+    assert!(
+        many.start_scores
+            .iter()
+            .all(|&x| x <= many.start_scores[many.start])
+    );
+    // Deterministic, and zero starts is a usage error.
+    assert_eq!(run(5, None).segmentation, many.segmentation);
+    assert!(
+        segment_collection(nodes_from(&tables, &areas), &meshes, &{
+            let mut o = opts.clone();
+            o.starts = 0;
+            o
+        })
+        .is_err()
+    );
+}

@@ -45,6 +45,10 @@ pub struct SegmentArgs {
     /// distinctive vertex.
     #[arg(long)]
     seed: Option<u64>,
+    /// Co-segment from this many starts (the default start, then seeded ones) and keep the one
+    /// with the highest mean region confidence. See docs/PARTS.md.
+    #[arg(long, default_value_t = SegmentCollectionOptions::default().starts)]
+    starts: usize,
     /// Collections up to this size use a complete shape graph; larger ones a nearest-neighbour
     /// graph.
     #[arg(long, default_value_t = GraphOptions::default().complete_limit)]
@@ -206,6 +210,7 @@ fn collection_options(
         opts
     });
     o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
+    o2.starts = args.starts;
     o2.parts = args.parts.map(|p| {
         let mut o = AdaptiveOptions::default();
         if let PartsArg::Count(k) = p {

@@ -37,7 +37,7 @@ pub use load_collection::{
 };
 pub use refine_cosegmentation::refine_cosegmentation;
 pub use segment_collection::{
-    SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection,
+    SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection, start_score,
 };
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
 pub use stable_cycle::{

@@ -97,6 +97,19 @@ pub struct CollectionSummary {
     /// candidates (absent otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub parts: Option<crate::graph::PartsReport>,
+    /// With several starts (`--starts N`): the start kept and every start's score (mean tuple
+    /// confidence); absent with one start.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub starts: Option<StartsReport>,
+}
+
+/// Which of several co-segmentation starts was kept ([`SegmentCollectionOptions::starts`]).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct StartsReport {
+    /// Index of the start kept (0 = the default start).
+    pub chosen: usize,
+    /// Mean tuple confidence of each start ([`crate::graph::start_score`]).
+    pub scores: Vec<f64>,
 }
 
 impl CollectionSummary {
@@ -176,6 +189,10 @@ impl CollectionSummary {
             options: options.clone(),
             skipped,
             parts: None,
+            starts: (result.start_scores.len() > 1).then(|| StartsReport {
+                chosen: result.start,
+                scores: result.start_scores.clone(),
+            }),
         }
     }
 }

@@ -26,6 +26,7 @@ mod write_regions;
 pub use crate::render::region_colors;
 pub use collection_summary::{
     CollectionEdge, CollectionRegion, CollectionShape, CollectionSummary, SkippedInput,
+    StartsReport,
 };
 pub use export_features::{ExportFormat, ExportOptions, export_features};
 pub use pair_summary::{PairSummary, RegionSummary, ShapeSummary};
