@@ -664,6 +664,61 @@ mod zoomout_descriptors {
         };
         assert!(zoomout(ga, fewer, &truth, &ZoomOutOptions::default()).is_err());
     }
+    /// Per-column weights: a zero weight silences a misleading column, equal weights change
+    /// nothing, and a weight per column is required.
+    #[test]
+    fn zoomout_descriptor_weights_scale_each_column() {
+        let a = blob(3);
+        let perm = permutation(a.vertex_count(), 7);
+        let b = permute_mesh(&a, &perm);
+        let opts = SpectrumOptions::with_eigenpairs(40);
+        let (sa, sb) = (
+            laplace_beltrami_spectrum(&a, &opts).unwrap(),
+            laplace_beltrami_spectrum(&b, &opts).unwrap(),
+        );
+        // Coordinates, then a column of noise unrelated between the two shapes.
+        let noise = |n: usize, seed: u64| {
+            let mut x = seed | 1;
+            (0..n)
+                .map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    (x >> 11) as f64 / (1u64 << 53) as f64
+                })
+                .collect::<Vec<f64>>()
+        };
+        let mut da = coordinates(a.positions());
+        da.extend(noise(a.vertex_count(), 1));
+        let mut db = coordinates(b.positions());
+        db.extend(noise(b.vertex_count(), 2));
+        let ga = ShapeGeometry {
+            spectrum: &sa,
+            positions: a.positions(),
+            descriptors: Some(&da),
+        };
+        let gb = ShapeGeometry {
+            spectrum: &sb,
+            positions: b.positions(),
+            descriptors: Some(&db),
+        };
+        let truth: Vec<u32> = perm.iter().map(|&o| o as u32).collect();
+        let run = |weights: Option<Vec<f64>>| {
+            let mut o = ZoomOutOptions::default();
+            (o.initial_size, o.final_size, o.step, o.samples) = (6, 40, 5, 300);
+            o.descriptor_weight = 1e6;
+            o.final_match = FinalMatch::Nearest;
+            o.descriptor_weights = weights;
+            zoomout(ga, gb, &truth, &o)
+        };
+        let plain = run(None).unwrap();
+        assert_ne!(plain, truth, "the noise column should mislead the match");
+        assert_eq!(run(Some(vec![1.0, 1.0, 1.0, 0.0])).unwrap(), truth);
+        assert_eq!(run(Some(vec![2.0; 4])).unwrap(), plain);
+        assert!(run(Some(vec![1.0; 3])).is_err());
+        assert!(run(Some(vec![0.0; 4])).is_err());
+        assert!(run(Some(vec![1.0, 1.0, f64::NAN, 1.0])).is_err());
+    }
 }
 
 mod auction {

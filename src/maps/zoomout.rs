@@ -32,6 +32,13 @@ pub struct ZoomOutOptions {
     /// How the last point map is read from the embeddings (default
     /// [`FinalMatch::default`]: a near-bijective assignment).
     pub final_match: FinalMatch,
+    /// Relative weight of each descriptor column in the last search (`None`, default: equal).
+    /// Column `j` counts `w_j / mean(w)` times in the squared distance, so the feature
+    /// families' shares of the band affinity ([`crate::stable::SegmentPairOptions::feature_weights`])
+    /// also hold here; `segment_pair` sets it from them. Not serialised (it is derived from the
+    /// pipeline's options, which are).
+    #[serde(skip)]
+    pub descriptor_weights: Option<Vec<f64>>,
 }
 
 impl Default for ZoomOutOptions {
@@ -43,6 +50,7 @@ impl Default for ZoomOutOptions {
             samples: 2000,
             descriptor_weight: 0.0,
             final_match: FinalMatch::default(),
+            descriptor_weights: None,
         }
     }
 }
@@ -247,10 +255,11 @@ pub(crate) fn zoomout_from(
     match (a.descriptors, b.descriptors) {
         (Some(da), Some(db)) if lambda > 0.0 => {
             let plain = base;
-            let base = with_descriptors(plain.as_ref(), da, lambda);
+            let w = options.descriptor_weights.as_deref();
+            let base = with_descriptors(plain.as_ref(), da, lambda, w)?;
             // The plain embedding is not needed any more: free it before the search.
             drop(plain);
-            let query = with_descriptors(phi_b.subcols(0, k), db, lambda);
+            let query = with_descriptors(phi_b.subcols(0, k), db, lambda, w)?;
             final_point_map(&base, query.as_ref(), &options.final_match)
         }
         _ => final_point_map(&base, phi_b.subcols(0, k), &options.final_match),
@@ -276,24 +285,45 @@ fn final_point_map(
 }
 
 /// `[x | λ D̂]`: `x` (`d × k`) with the descriptors appended as columns, each scaled to unit
-/// Euclidean norm and then by `λ`.
-fn with_descriptors(x: MatRef<'_, f64>, descriptors: &[f64], lambda: f64) -> Mat<f64> {
+/// Euclidean norm and then by `λ` (and by `√(w_j / mean w)` with per-column weights).
+fn with_descriptors(
+    x: MatRef<'_, f64>,
+    descriptors: &[f64],
+    lambda: f64,
+    weights: Option<&[f64]>,
+) -> Result<Mat<f64>, SpectralError> {
     let (d, k) = (x.nrows(), x.ncols());
     let n = descriptors.len() / d;
+    let relative: Option<Vec<f64>> = match weights {
+        None => None,
+        Some(w) => {
+            let mean = w.iter().sum::<f64>() / w.len().max(1) as f64;
+            if w.len() != n || !(mean > 0.0) || w.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+                return Err(SpectralError::InvalidOption(format!(
+                    "ZoomOut: {} descriptor weights for {n} descriptor columns (they must be \
+                     finite, non-negative and not all zero)",
+                    w.len()
+                )));
+            }
+            Some(w.iter().map(|x| (x / mean).sqrt()).collect())
+        }
+    };
     let scales: Vec<f64> = descriptors
         .chunks_exact(d)
-        .map(|col| {
+        .enumerate()
+        .map(|(j, col)| {
             let norm = col.iter().map(|v| v * v).sum::<f64>().sqrt();
-            if norm > 0.0 { lambda / norm } else { 0.0 }
+            let s = if norm > 0.0 { lambda / norm } else { 0.0 };
+            relative.as_ref().map_or(s, |r| s * r[j])
         })
         .collect();
-    Mat::from_fn(d, k + n, |i, j| {
+    Ok(Mat::from_fn(d, k + n, |i, j| {
         if j < k {
             x[(i, j)]
         } else {
             scales[j - k] * descriptors[(j - k) * d + i]
         }
-    })
+    }))
 }
 
 /// The first `k` eigenvectors as a `d × k` view.

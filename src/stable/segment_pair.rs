@@ -144,7 +144,11 @@ pub fn segment_pair(
 ) -> Result<SegmentedPair, StableError> {
     check_sizes(a, b)?;
     let resolved = options.map_step.resolve(a.spectrum, b.spectrum)?;
-    let (map_guided_options, map_preset) = (resolved.options, resolved.preset);
+    let (mut map_guided_options, map_preset) = (resolved.options, resolved.preset);
+    // The map step's descriptor term weighs the columns as the affinity does.
+    if let Some(m) = map_guided_options.as_mut() {
+        m.point_map.zoomout.descriptor_weights = options.feature_weights.clone();
+    }
     check_stage_options(options.refine.as_ref(), map_guided_options.as_ref())?;
     let mut times = PairTimes::default();
     let mut fallbacks = Vec::new();
