@@ -198,7 +198,7 @@ pub fn segment_collection(
         let t = Instant::now();
         let (mut segmentation, adaptive) = match &options.parts {
             None => {
-                let mut o = options.cosegment.clone();
+                let mut o = options.cosegment;
                 if start > 0 {
                     o.seed = Some(o.seed.unwrap_or(0) + start as u64);
                 }

@@ -298,7 +298,8 @@ fn with_descriptors(
         None => None,
         Some(w) => {
             let mean = w.iter().sum::<f64>() / w.len().max(1) as f64;
-            if w.len() != n || !(mean > 0.0) || w.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+            let bad = |x: &f64| !x.is_finite() || *x < 0.0;
+            if w.len() != n || mean.is_nan() || mean <= 0.0 || w.iter().any(bad) {
                 return Err(SpectralError::InvalidOption(format!(
                     "ZoomOut: {} descriptor weights for {n} descriptor columns (they must be \
                      finite, non-negative and not all zero)",
