@@ -599,7 +599,8 @@ mod zoomout_map {
 mod zoomout_descriptors {
     use super::common::features::{blob, permutation, permute_mesh};
     use coseg::maps::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
-    use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
+    use coseg::mesh::TriMesh;
+    use coseg::spectral::{Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
 
     /// Coordinates as three feature-major descriptor columns: on a vertex-permuted copy they
     /// identify every vertex exactly.
@@ -607,28 +608,34 @@ mod zoomout_descriptors {
         (0..3).flat_map(|c| pos.iter().map(move |p| p[c])).collect()
     }
 
-    #[test]
-    fn zoomout_descriptors_decide_the_last_match() {
+    /// A blob, a vertex-permuted copy, their 40 eigenpairs and the true map (B to A).
+    fn permuted_blob(seed: u64) -> (TriMesh, TriMesh, Spectrum, Spectrum, Vec<u32>) {
         let a = blob(3);
-        let perm = permutation(a.vertex_count(), 5);
+        let perm = permutation(a.vertex_count(), seed);
         let b = permute_mesh(&a, &perm);
         let opts = SpectrumOptions::with_eigenpairs(40);
         let (sa, sb) = (
             laplace_beltrami_spectrum(&a, &opts).unwrap(),
             laplace_beltrami_spectrum(&b, &opts).unwrap(),
         );
+        let truth = perm.iter().map(|&o| o as u32).collect();
+        (a, b, sa, sb, truth)
+    }
+
+    /// The geometry of `mesh` with its descriptors.
+    fn geometry<'a>(mesh: &'a TriMesh, s: &'a Spectrum, d: &'a [f64]) -> ShapeGeometry<'a> {
+        ShapeGeometry {
+            spectrum: s,
+            positions: mesh.positions(),
+            descriptors: Some(d),
+        }
+    }
+
+    #[test]
+    fn zoomout_descriptors_decide_the_last_match() {
+        let (a, b, sa, sb, truth) = permuted_blob(5);
         let (da, db) = (coordinates(a.positions()), coordinates(b.positions()));
-        let ga = ShapeGeometry {
-            spectrum: &sa,
-            positions: a.positions(),
-            descriptors: Some(&da),
-        };
-        let gb = ShapeGeometry {
-            spectrum: &sb,
-            positions: b.positions(),
-            descriptors: Some(&db),
-        };
-        let truth: Vec<u32> = perm.iter().map(|&o| o as u32).collect();
+        let (ga, gb) = (geometry(&a, &sa, &da), geometry(&b, &sb, &db));
         let run = |weight: f64| {
             let options = {
                 let mut opts = ZoomOutOptions::default();
@@ -668,14 +675,7 @@ mod zoomout_descriptors {
     /// nothing, and a weight per column is required.
     #[test]
     fn zoomout_descriptor_weights_scale_each_column() {
-        let a = blob(3);
-        let perm = permutation(a.vertex_count(), 7);
-        let b = permute_mesh(&a, &perm);
-        let opts = SpectrumOptions::with_eigenpairs(40);
-        let (sa, sb) = (
-            laplace_beltrami_spectrum(&a, &opts).unwrap(),
-            laplace_beltrami_spectrum(&b, &opts).unwrap(),
-        );
+        let (a, b, sa, sb, truth) = permuted_blob(7);
         // Coordinates, then a column of noise unrelated between the two shapes.
         let noise = |n: usize, seed: u64| {
             let mut x = seed | 1;
@@ -692,17 +692,7 @@ mod zoomout_descriptors {
         da.extend(noise(a.vertex_count(), 1));
         let mut db = coordinates(b.positions());
         db.extend(noise(b.vertex_count(), 2));
-        let ga = ShapeGeometry {
-            spectrum: &sa,
-            positions: a.positions(),
-            descriptors: Some(&da),
-        };
-        let gb = ShapeGeometry {
-            spectrum: &sb,
-            positions: b.positions(),
-            descriptors: Some(&db),
-        };
-        let truth: Vec<u32> = perm.iter().map(|&o| o as u32).collect();
+        let (ga, gb) = (geometry(&a, &sa, &da), geometry(&b, &sb, &db));
         let run = |weights: Option<Vec<f64>>| {
             let mut o = ZoomOutOptions::default();
             (o.initial_size, o.final_size, o.step, o.samples) = (6, 40, 5, 300);
