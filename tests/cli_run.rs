@@ -411,3 +411,59 @@ fn help_shows_an_example_for_every_subcommand_and_the_shared_flags() {
         assert!(help.contains("--threads"), "{cmd}");
     }
 }
+
+/// `--starts N` records the kept start and every score; one start (the default) writes no
+/// `starts` entry, and the kept start's regions are those of its own seeded run.
+#[test]
+fn segment_starts_records_the_choice_and_keeps_that_starts_regions() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 3, 2);
+    let run_with = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
+        args.extend(FAST);
+        args.extend(extra);
+        let run = coseg(&args);
+        assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        (out, summary)
+    };
+    let (_, one) = run_with("one", &[]);
+    assert!(one.get("starts").is_none());
+    let (many_out, many) = run_with("many", &["--starts", "3"]);
+    let chosen = many["starts"]["chosen"].as_u64().unwrap();
+    let scores = many["starts"]["scores"].as_array().unwrap();
+    assert_eq!(scores.len(), 3);
+    let best = scores
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .fold(f64::MIN, f64::max);
+    assert_eq!(scores[chosen as usize].as_f64().unwrap(), best);
+    let seed = chosen.to_string();
+    let (single_out, _) = if chosen == 0 {
+        run_with("single", &[])
+    } else {
+        run_with("single", &["--seed", &seed])
+    };
+    for name in ["s0", "s1", "s2"] {
+        let file = format!("{name}.regions.txt");
+        assert_eq!(
+            std::fs::read(many_out.join(&file)).unwrap(),
+            std::fs::read(single_out.join(&file)).unwrap(),
+            "{file}"
+        );
+    }
+    let bad = coseg(&[
+        "segment",
+        s(&input),
+        "-o",
+        s(&dir.path().join("bad")),
+        "--starts",
+        "0",
+    ]);
+    assert_ne!(bad.status.code(), Some(0));
+}
