@@ -199,6 +199,19 @@ pub(crate) fn validate(
             descriptor_columns[0], descriptor_columns[1]
         )));
     }
+    if let Some(w) = &options.descriptor_weights {
+        let sum: f64 = w.iter().sum();
+        let bad = |x: &f64| !x.is_finite() || *x < 0.0;
+        let columns_differ = descriptor_columns.first().is_some_and(|&n| n != w.len());
+        if columns_differ || w.iter().any(bad) || sum.is_nan() || sum <= 0.0 {
+            return Err(SpectralError::InvalidOption(format!(
+                "{} descriptor weights for {:?} descriptor columns (they must be one per \
+                 column, finite, non-negative and not all zero)",
+                w.len(),
+                descriptor_columns.first()
+            )));
+        }
+    }
     if !(options.descriptor_weight.is_finite() && options.descriptor_weight >= 0.0) {
         return Err(SpectralError::InvalidOption(format!(
             "descriptor_weight = {} must be finite and non-negative",
@@ -256,10 +269,10 @@ pub(crate) fn zoomout_from(
         (Some(da), Some(db)) if lambda > 0.0 => {
             let plain = base;
             let w = options.descriptor_weights.as_deref();
-            let base = with_descriptors(plain.as_ref(), da, lambda, w)?;
+            let base = with_descriptors(plain.as_ref(), da, lambda, w);
             // The plain embedding is not needed any more: free it before the search.
             drop(plain);
-            let query = with_descriptors(phi_b.subcols(0, k), db, lambda, w)?;
+            let query = with_descriptors(phi_b.subcols(0, k), db, lambda, w);
             final_point_map(&base, query.as_ref(), &options.final_match)
         }
         _ => final_point_map(&base, phi_b.subcols(0, k), &options.final_match),
@@ -291,24 +304,14 @@ fn with_descriptors(
     descriptors: &[f64],
     lambda: f64,
     weights: Option<&[f64]>,
-) -> Result<Mat<f64>, SpectralError> {
+) -> Mat<f64> {
     let (d, k) = (x.nrows(), x.ncols());
     let n = descriptors.len() / d;
-    let relative: Option<Vec<f64>> = match weights {
-        None => None,
-        Some(w) => {
-            let mean = w.iter().sum::<f64>() / w.len().max(1) as f64;
-            let bad = |x: &f64| !x.is_finite() || *x < 0.0;
-            if w.len() != n || mean.is_nan() || mean <= 0.0 || w.iter().any(bad) {
-                return Err(SpectralError::InvalidOption(format!(
-                    "ZoomOut: {} descriptor weights for {n} descriptor columns (they must be \
-                     finite, non-negative and not all zero)",
-                    w.len()
-                )));
-            }
-            Some(w.iter().map(|x| (x / mean).sqrt()).collect())
-        }
-    };
+    // Checked by `validate`: one finite, non-negative weight per column, not all zero.
+    let relative: Option<Vec<f64>> = weights.map(|w| {
+        let mean = w.iter().sum::<f64>() / w.len() as f64;
+        w.iter().map(|x| (x / mean).sqrt()).collect()
+    });
     let scales: Vec<f64> = descriptors
         .chunks_exact(d)
         .enumerate()
@@ -318,13 +321,13 @@ fn with_descriptors(
             relative.as_ref().map_or(s, |r| s * r[j])
         })
         .collect();
-    Ok(Mat::from_fn(d, k + n, |i, j| {
+    Mat::from_fn(d, k + n, |i, j| {
         if j < k {
             x[(i, j)]
         } else {
             scales[j - k] * descriptors[(j - k) * d + i]
         }
-    }))
+    })
 }
 
 /// The first `k` eigenvectors as a `d × k` view.

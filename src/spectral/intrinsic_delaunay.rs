@@ -16,7 +16,7 @@
 //! kinds); their weights can stay negative. The tufted cover of Sharp & Crane 2020, which
 //! would also flip around non-manifold edges, is not implemented.
 
-use super::surface_operators::{MAX_COTANGENT, assemble};
+use super::surface_operators::{assemble, halved_within_bound};
 use crate::mesh::{TriMesh, norm, sub};
 use faer::sparse::SparseColMat;
 use std::collections::HashMap;
@@ -106,7 +106,7 @@ impl IntrinsicDelaunay {
 
     /// `cot(θ_k) / 2` per corner of the intrinsic triangles (`F × 3`), under the rule of
     /// [`crate::spectral::SurfaceOperators`] (degenerate faces give zeros; one common factor
-    /// when a cotangent exceeds [`MAX_COTANGENT`]).
+    /// when a cotangent exceeds [`MAX_COTANGENT`](crate::spectral::MAX_COTANGENT)).
     pub fn half_cotangents(&self) -> Vec<[f64; 3]> {
         self.lengths
             .iter()
@@ -279,16 +279,8 @@ fn half_cotangents_of_lengths(l: &[f64; 3]) -> [f64; 3] {
         return [0.0; 3];
     }
     // Corner k lies between edges k and k+2; the edge facing it is k+1.
-    let mut cot = [0, 1, 2].map(|k| {
+    halved_within_bound([0, 1, 2].map(|k| {
         let (u, v, w) = (l[k], l[(k + 2) % 3], l[(k + 1) % 3]);
         (u * u + v * v - w * w) / (4.0 * area)
-    });
-    let big = cot.iter().fold(0.0f64, |a, c| a.max(c.abs()));
-    if big > MAX_COTANGENT {
-        let s = MAX_COTANGENT / big;
-        for c in cot.iter_mut() {
-            *c *= s;
-        }
-    }
-    cot.map(|c| 0.5 * c)
+    }))
 }

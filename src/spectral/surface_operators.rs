@@ -90,13 +90,23 @@ pub struct SurfaceOperators {
 impl SurfaceOperators {
     /// Computes the operators of `mesh`: O(F) time and memory.
     pub fn new(mesh: &TriMesh) -> Self {
-        let half_cotangents = half_cotangents(mesh);
-        let laplacian = assemble(mesh.vertex_count(), mesh.faces(), &half_cotangents);
+        Self::on(mesh, None, half_cotangents(mesh), mesh.vertex_areas())
+    }
+
+    /// The operators from per-corner weights on `faces` (`None`: the mesh's own) and lumped
+    /// areas; the unit-area mass is taken against the mesh's area either way.
+    fn on(
+        mesh: &TriMesh,
+        faces: Option<Vec<[u32; 3]>>,
+        half_cotangents: Vec<[f64; 3]>,
+        vertex_areas: Vec<f64>,
+    ) -> Self {
+        let triangles = faces.as_deref().unwrap_or(mesh.faces());
+        let laplacian = assemble(mesh.vertex_count(), triangles, &half_cotangents);
         let total_area = mesh.total_area();
-        let vertex_areas = mesh.vertex_areas();
         let unit_mass = vertex_areas.iter().map(|m| m / total_area).collect();
         SurfaceOperators {
-            faces: None,
+            faces,
             half_cotangents,
             laplacian,
             vertex_areas,
@@ -125,21 +135,14 @@ impl SurfaceOperators {
         match kind {
             LaplacianKind::Cotangent => Self::new(mesh),
             LaplacianKind::IntrinsicDelaunay => {
-                let d = mesh.vertex_count();
                 let idt = super::IntrinsicDelaunay::new(mesh);
-                let half_cotangents = idt.half_cotangents();
-                let laplacian = assemble(d, idt.faces(), &half_cotangents);
-                let total_area = mesh.total_area();
-                let vertex_areas = idt.vertex_areas(d);
-                let unit_mass = vertex_areas.iter().map(|m| m / total_area).collect();
-                SurfaceOperators {
-                    faces: Some(idt.faces().to_vec()),
-                    half_cotangents,
-                    laplacian,
-                    vertex_areas,
-                    unit_mass,
-                    total_area,
-                }
+                let areas = idt.vertex_areas(mesh.vertex_count());
+                Self::on(
+                    mesh,
+                    Some(idt.faces().to_vec()),
+                    idt.half_cotangents(),
+                    areas,
+                )
             }
         }
     }
@@ -225,18 +228,23 @@ fn half_cotangents(mesh: &TriMesh) -> Vec<[f64; 3]> {
                 }
                 *ck = dot(u, v) / c;
             }
-            // One factor for the three (c₀c₁ + c₁c₂ + c₂c₀ = 1 > 0 survives a common positive
-            // factor; a separate clamp per corner does not).
-            let big = cot.iter().fold(0.0f64, |a, c| a.max(c.abs()));
-            if big > MAX_COTANGENT {
-                let s = MAX_COTANGENT / big;
-                for c in cot.iter_mut() {
-                    *c *= s;
-                }
-            }
-            cot.map(|c| 0.5 * c)
+            halved_within_bound(cot)
         })
         .collect()
+}
+
+/// The rule's last step, shared by every triangulation: `cot / 2` per corner, all three scaled
+/// by one factor when the largest `|cot|` exceeds [`MAX_COTANGENT`] (c₀c₁ + c₁c₂ + c₂c₀ = 1 > 0
+/// survives a common positive factor; a separate clamp per corner does not).
+pub(super) fn halved_within_bound(mut cot: [f64; 3]) -> [f64; 3] {
+    let big = cot.iter().fold(0.0f64, |a, c| a.max(c.abs()));
+    if big > MAX_COTANGENT {
+        let s = MAX_COTANGENT / big;
+        for c in cot.iter_mut() {
+            *c *= s;
+        }
+    }
+    cot.map(|c| 0.5 * c)
 }
 
 /// The `d × d` Laplacian of `faces` with per-corner weights `half_cotangents` (weight of the
