@@ -90,6 +90,17 @@ def main():
     pos, faces = read_off(args.mesh)
     L, M = cotan_laplacian_and_mass(pos, faces)
     build = time.perf_counter() - t0
+    try:
+        # The BLAS SciPy runs on, as its users get it: no thread or core-type overrides.
+        from threadpoolctl import threadpool_info
+
+        blas = [
+            f"{i['internal_api']} {i.get('version')} {i.get('architecture')} "
+            f"threads={i['num_threads']}"
+            for i in threadpool_info()
+        ]
+    except ImportError:
+        blas = ["threadpoolctl not installed"]
     times = []
     vals = None
     for _ in range(args.repeat):
@@ -103,6 +114,7 @@ def main():
         "k": args.k,
         "sigma": args.sigma,
         "build_seconds": build,
+        "blas": blas,
         "eigsh_seconds": times,
         "eigenvalues": vals.tolist(),
     }
@@ -110,6 +122,7 @@ def main():
         print(json.dumps(out))
     else:
         print(f"{args.mesh}: {len(pos)} vertices, k={args.k}, sigma={args.sigma}")
+        print("blas:", "; ".join(blas))
         print(f"build {build:.3f} s, eigsh {' '.join(f'{t:.3f}' for t in times)} s")
         print("first eigenvalues:", " ".join(f"{v:.9e}" for v in vals[:8]))
         print("last eigenvalue:", f"{vals[-1]:.9e}")

@@ -1166,3 +1166,34 @@ mod intrinsic_delaunay {
         assert!(i.len() > d.len());
     }
 }
+
+/// The solver's thread count is a speed setting, not a result setting: the spectrum is
+/// bit-identical sequential and on any pool, which is why it is left out of the cache key.
+#[test]
+fn spectrum_is_bit_identical_across_thread_counts() {
+    // 10,242 vertices: large enough for the parallel products to split their work.
+    let (mut p, f) = icosphere_parts(5, 1.0);
+    jitter(&mut p, 0.02, 11);
+    let mesh = TriMesh::new(p, f).unwrap();
+    let solve = |pool_threads: usize, solver_threads: usize| {
+        let mut opts = sparse_opts(60);
+        opts.threads = solver_threads;
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(pool_threads)
+            .build()
+            .unwrap()
+            .install(|| laplace_beltrami_spectrum(&mesh, &opts).unwrap())
+    };
+    let sequential = solve(1, 1);
+    for (pool, solver) in [(2, 0), (3, 0), (2, 2), (4, 1)] {
+        let s = solve(pool, solver);
+        assert_eq!(s.eigenvalues, sequential.eigenvalues, "pool {pool}, solver {solver}");
+        assert!(
+            s.eigenvectors
+                .iter()
+                .zip(&sequential.eigenvectors)
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "pool {pool}, solver {solver}: eigenvectors differ"
+        );
+    }
+}
