@@ -1187,7 +1187,10 @@ fn spectrum_is_bit_identical_across_thread_counts() {
     let sequential = solve(1, 1);
     for (pool, solver) in [(2, 0), (3, 0), (2, 2), (4, 1)] {
         let s = solve(pool, solver);
-        assert_eq!(s.eigenvalues, sequential.eigenvalues, "pool {pool}, solver {solver}");
+        assert_eq!(
+            s.eigenvalues, sequential.eigenvalues,
+            "pool {pool}, solver {solver}"
+        );
         assert!(
             s.eigenvectors
                 .iter()

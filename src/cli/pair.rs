@@ -298,6 +298,14 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         ratio,
         written.len(),
     );
+    let t = &pair.times;
+    println!(
+        "stages: algorithm {:.2} s, smoothers {:.2} s, refinement {:.2} s, map step {:.2} s",
+        t.algorithm.as_secs_f64(),
+        t.smoothers.as_secs_f64(),
+        t.refine.as_secs_f64(),
+        t.map_guided.as_secs_f64()
+    );
     Ok(ExitCode::SUCCESS)
 }
 

@@ -112,38 +112,46 @@ pub fn auction_assignment(
     let mut map = vec![0u32; queries];
     let mut bids = 0usize;
     let epsilon = options.epsilon * scale;
-    // The cheapest slot of every target (the first of equal prices), kept up to date: a bid
-    // reads one price per candidate instead of `capacity`.
+    // The cheapest slot of every target (the first of equal prices) and its price, kept up
+    // to date: a bid reads one price per candidate, with no dependent read of the slot.
     let mut cheapest: Vec<u32> = (0..target_count).map(|t| (t * capacity) as u32).collect();
+    let mut cheapest_price = vec![0.0f64; target_count];
     let mut queue: VecDeque<usize> = (0..queries).collect();
     while let Some(q) = queue.pop_front() {
         bids += 1;
         let targets = &candidates.targets[q * k..(q + 1) * k];
         let costs = &candidates.costs[q * k..(q + 1) * k];
         let outside = -(costs[0] + penalty);
-        let (mut best, mut second, mut best_slot) = (outside, f64::NEG_INFINITY, None);
+        let (mut best, mut second, mut best_target) = (outside, f64::NEG_INFINITY, None);
         for (&t, &cost) in targets.iter().zip(costs) {
-            let slot = cheapest[t as usize] as usize;
-            let value = -cost - price[slot];
+            // Prices are never negative and costs ascend, so once `-cost` cannot beat the
+            // second best no later candidate can either: the rest of the list is skipped
+            // with exactly the result of scanning it.
+            if -cost <= second {
+                break;
+            }
+            let value = -cost - cheapest_price[t as usize];
             if value > best {
                 second = best;
                 best = value;
-                best_slot = Some(slot);
+                best_target = Some(t as usize);
             } else if value > second {
                 second = value;
             }
         }
-        let Some(slot) = best_slot else {
+        let Some(t) = best_target else {
             map[q] = targets[0];
             continue;
         };
+        let slot = cheapest[t] as usize;
         price[slot] += best - second + epsilon;
-        let t = slot / capacity;
-        cheapest[t] = (t * capacity..(t + 1) * capacity)
-            .min_by(|&x, &y| price[x].total_cmp(&price[y]))
-            .expect("capacity is at least 1") as u32;
+        let (low, at) = (t * capacity..(t + 1) * capacity)
+            .map(|x| (price[x], x))
+            .min_by(|x, y| x.0.total_cmp(&y.0))
+            .expect("capacity is at least 1");
+        (cheapest[t], cheapest_price[t]) = (at as u32, low);
         let previous = std::mem::replace(&mut owner[slot], q as u32);
-        map[q] = (slot / capacity) as u32;
+        map[q] = t as u32;
         if previous != u32::MAX {
             queue.push_back(previous as usize);
         }

@@ -1,6 +1,7 @@
 //! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
 //! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
 
+use super::nearest_rows::gather_rows;
 use super::{AuctionOptions, CandidateLists, auction_assignment};
 use crate::spectral::{SpectralError, Spectrum};
 use faer::linalg::matmul::matmul;
@@ -321,13 +322,21 @@ fn with_descriptors(
             relative.as_ref().map_or(s, |r| s * r[j])
         })
         .collect();
-    Mat::from_fn(d, k + n, |i, j| {
-        if j < k {
-            x[(i, j)]
-        } else {
-            scales[j - k] * descriptors[(j - k) * d + i]
+    let mut out = Mat::<f64>::zeros(d, k + n);
+    for j in 0..k {
+        out.col_mut(j).copy_from(x.col(j));
+    }
+    for (j, col) in descriptors.chunks_exact(d).enumerate() {
+        let dst = out
+            .col_mut(k + j)
+            .try_as_col_major_mut()
+            .expect("owned")
+            .as_slice_mut();
+        for (o, &v) in dst.iter_mut().zip(col) {
+            *o = scales[j] * v;
         }
-    })
+    }
+    out
 }
 
 /// The first `k` eigenvectors as a `d × k` view.
@@ -435,7 +444,7 @@ fn sample_rows(phi: MatRef<'_, f64>, positions: &[[f64; 3]], count: usize) -> Ma
         out
     };
     let chosen = cover_basis(phi, chosen);
-    Mat::from_fn(chosen.len(), phi.ncols(), |i, j| phi[(chosen[i], j)])
+    gather_rows(phi, &chosen)
 }
 
 /// `chosen` plus, for every column of `phi` that (almost) vanishes on the chosen rows, the
