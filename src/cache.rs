@@ -25,15 +25,15 @@
 //!
 //! | file | value | content | bytes (≈) |
 //! |---|---|---|---|
-//! | `<key>.coseg-shape` ([`EntryKind::Full`]) | [`crate::pipeline::StoredShape`] | eigenvalues (f64), eigenvectors (**f32**, `d × k`), vertex areas (f64), the sdf and user feature columns (f64) when those families are on | `4·d·k + 8·d` (10k vertices: 8.1 MB) |
-//! | `<key>.coseg-bands` ([`EntryKind::Bands`]) | [`crate::pipeline::ShapeBands`] | band table (u8, `d × N`), vertex areas (f64), deflated | about `d·N / 6 + 8·d` (10k: 0.5–0.6 MB) |
+//! | `<key>.coseg-shape` ([`EntryKind::Full`]) | [`crate::pipeline::StoredShape`] | eigenvalues (f64), eigenvectors (**f32**, `d × k`), vertex areas (f64), the sdf and user feature columns (f64) when those families are on, band table (u8 `d × N`, deflated inside the payload) | `4·d·k + 8·d + d·N/6` (10k vertices: 8.6 MB) |
+//! | `<key>.coseg-bands` ([`EntryKind::Bands`]) | [`crate::pipeline::ShapeBands`] | band table (u8, `d × N`), vertex areas (f64), the whole payload deflated | about `d·N / 6 + 8·d` (10k: 0.5 MB) |
 //!
-//! The descriptors (spectral and extrinsic) and the band table are not in the full entry: a
-//! warm load recomputes them from the stored spectrum with the cold run's own code
-//! ([`crate::pipeline::StoredShape::into_shape_data`]), 0.1–0.2 s for 10k vertices, and gets
-//! the same bits because the pipeline rounds the eigenvectors to `f32` before anything uses
-//! them. Format 3 stored all of it in f64 (43 MB for 10k vertices, 227 MB for 52k); such
-//! entries read as stale and are recomputed. Measurements and the reasoning:
+//! The descriptors (spectral and extrinsic) are not in the full entry: a warm load recomputes
+//! them from the stored spectrum with the cold run's own code
+//! ([`crate::pipeline::StoredShape::into_shape_data`]), about 0.07 s for 10k vertices, and
+//! gets the same bits because the pipeline rounds the eigenvectors to `f32` before anything
+//! uses them. Format 3 stored everything in f64 (43 MB for 10k vertices, 227 MB for 52k);
+//! such entries read as stale and are recomputed. Measurements and the reasoning:
 //! `docs/PERFORMANCE.md`, "Compact cache".
 
 use crate::mesh::{TriMesh, write_atomic};
@@ -83,10 +83,10 @@ impl EntryKind {
         }
     }
 
-    /// True when the payload of such a file is deflate-compressed (see the module docs): the
-    /// band table of the compact entry shrinks about 6× for a few ms per read, while the
-    /// `f32` eigenvectors of the full entry would shrink only 7 % (16 % with a byte shuffle)
-    /// for a fifth of a second per write.
+    /// True when the whole payload of such a file is deflate-compressed (see the module
+    /// docs): the compact entry is mostly its band table, which shrinks about 6× for a few ms
+    /// per read. The full entry deflates only its band table: its `f32` eigenvectors would
+    /// shrink by 7 % (16 % with a byte shuffle) for a quarter of a second per write.
     pub fn compressed(self) -> bool {
         matches!(self, EntryKind::Bands)
     }
@@ -282,7 +282,7 @@ pub fn encode_entry<T: Serialize>(kind: EntryKind, key: &ShapeKey, value: &T) ->
 }
 
 /// `length of raw (u64 LE) | raw deflated`.
-fn deflate(raw: &[u8]) -> Vec<u8> {
+pub(crate) fn deflate(raw: &[u8]) -> Vec<u8> {
     use flate2::{Compression, write::DeflateEncoder};
     let header = (raw.len() as u64).to_le_bytes().to_vec();
     let mut encoder = DeflateEncoder::new(header, Compression::new(DEFLATE_LEVEL));
@@ -295,7 +295,7 @@ fn deflate(raw: &[u8]) -> Vec<u8> {
 /// The raw bytes of a [`deflate`]d payload. A length that deflate cannot reach from this many
 /// bytes, a stream that does not inflate to exactly that length or leaves bytes unread, is
 /// refused, so no input makes it allocate more than [`MAX_INFLATE_RATIO`] × its size.
-fn inflate(stored: &[u8]) -> Result<Vec<u8>, String> {
+pub(crate) fn inflate(stored: &[u8]) -> Result<Vec<u8>, String> {
     use flate2::read::DeflateDecoder;
     use std::io::Read;
     let Some((len, body)) = stored.split_first_chunk::<8>() else {
