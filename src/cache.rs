@@ -60,7 +60,8 @@ const MAX_INFLATE_RATIO: u64 = 1040;
 /// The kinds of entry a cache directory holds; each has its own magic and file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EntryKind {
-    /// Everything computed once per shape (spectrum, descriptors, bands).
+    /// What a shape's full data are rebuilt from (f32 spectrum, band table, the costly
+    /// feature columns; [`crate::pipeline::StoredShape`]).
     Full,
     /// The compact entry: band table and vertex areas only.
     Bands,

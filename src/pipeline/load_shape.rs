@@ -106,8 +106,9 @@ pub fn load_or_compute(
 
 /// The shape's band table and vertex areas: from the compact bands entry in `cache_dir` if it
 /// is valid, otherwise from [`load_or_compute`] (the full entry, or computed), after which the
-/// compact entry is written. Reading 10k vertices × 300 features this way costs about a tenth
-/// of reading the full entry, which is what makes a warm `coseg segment` fast.
+/// compact entry is written. For 10k vertices × 300 features this reads 0.5 MB instead of the
+/// full entry's 8.6 MB and rebuilds no descriptors, which is what makes a warm `coseg segment`
+/// fast.
 ///
 /// ```
 /// use coseg::cache::CacheOutcome;
