@@ -12,11 +12,29 @@
 //! File layout (all integers little-endian):
 //! `magic (8) | format version u32 | key (32) | payload length u64 | BLAKE3 of payload (32) |
 //! payload` where the payload is the bincode 2 (serde, standard config) encoding of the stored
-//! value. [`read_entry`] trusts a file only if the magic, version, key, length and checksum all
-//! match, the payload decodes with no trailing bytes and the caller's check of the decoded value
-//! passes; anything else is reported as untrusted with the reason. [`write_entry`] writes
-//! atomically (temporary file in the same directory, then rename), so a crash never leaves a
-//! half-written entry under a valid name.
+//! value, deflated for the kinds that say so ([`EntryKind::compressed`]: then the payload is
+//! `raw length u64 | deflate stream`). [`read_entry`] trusts a file only if the magic,
+//! version, key, length and checksum all match, the payload inflates to exactly its stated
+//! length (if compressed) and decodes with no trailing bytes, and the caller's check of the
+//! decoded value passes; anything else is reported as untrusted with the reason.
+//! [`write_entry`] writes atomically (temporary file in the same directory, then rename), so a
+//! crash never leaves a half-written entry under a valid name.
+//!
+//! # What the entries hold (format version 4)
+//! Per shape, at the default options (200 eigenpairs, 300 features, 20 bands), `d` vertices:
+//!
+//! | file | value | content | bytes (≈) |
+//! |---|---|---|---|
+//! | `<key>.coseg-shape` ([`EntryKind::Full`]) | [`crate::pipeline::StoredShape`] | eigenvalues (f64), eigenvectors (**f32**, `d × k`), vertex areas (f64), the sdf and user feature columns (f64) when those families are on, band table (u8 `d × N`, deflated inside the payload) | `4·d·k + 8·d + d·N/6` (10k vertices: 8.6 MB) |
+//! | `<key>.coseg-bands` ([`EntryKind::Bands`]) | [`crate::pipeline::ShapeBands`] | band table (u8, `d × N`), vertex areas (f64), the whole payload deflated | about `d·N / 6 + 8·d` (10k: 0.5 MB) |
+//!
+//! The descriptors (spectral and extrinsic) are not in the full entry: a warm load recomputes
+//! them from the stored spectrum with the cold run's own code
+//! ([`crate::pipeline::StoredShape::into_shape_data`]), about 0.07 s for 10k vertices, and
+//! gets the same bits because the pipeline rounds the eigenvectors to `f32` before anything
+//! uses them. Format 3 stored everything in f64 (43 MB for 10k vertices, 227 MB for 52k);
+//! such entries read as stale and are recomputed. Measurements and the reasoning:
+//! `docs/PERFORMANCE.md`, "Compact cache".
 
 use crate::mesh::{TriMesh, write_atomic};
 use serde::Serialize;
@@ -26,18 +44,24 @@ use std::path::{Path, PathBuf};
 
 /// Version of the cache file format and of the computations it stores. Bump it whenever the
 /// layout or any algorithm's output changes: older files then read as stale and are recomputed.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 const HEADER_LEN: usize = 8 + 4 + 32 + 8 + 32;
 /// File extension of full entries ([`EntryKind::Full`]).
 pub const CACHE_EXTENSION: &str = "coseg-shape";
 /// File extension of the compact bands entries ([`EntryKind::Bands`]).
 pub const BANDS_EXTENSION: &str = "coseg-bands";
+/// Deflate level of compressed payloads ([`EntryKind::compressed`]).
+const DEFLATE_LEVEL: u32 = 3;
+/// Deflate's largest expansion (a run of one byte: 258 bytes per 2-bit code, about 1032:1),
+/// plus slack: a compressed payload claiming more is refused before anything is allocated.
+const MAX_INFLATE_RATIO: u64 = 1040;
 
 /// The kinds of entry a cache directory holds; each has its own magic and file extension.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum EntryKind {
-    /// Everything computed once per shape (spectrum, descriptors, bands).
+    /// What a shape's full data are rebuilt from (f32 spectrum, band table, the costly
+    /// feature columns; [`crate::pipeline::StoredShape`]).
     Full,
     /// The compact entry: band table and vertex areas only.
     Bands,
@@ -58,6 +82,14 @@ impl EntryKind {
             EntryKind::Full => CACHE_EXTENSION,
             EntryKind::Bands => BANDS_EXTENSION,
         }
+    }
+
+    /// True when the whole payload of such a file is deflate-compressed (see the module
+    /// docs): the compact entry is mostly its band table, which shrinks about 6× for a few ms
+    /// per read. The full entry deflates only its band table: its `f32` eigenvectors would
+    /// shrink by 7 % (16 % with a byte shuffle) for a quarter of a second per write.
+    pub fn compressed(self) -> bool {
+        matches!(self, EntryKind::Bands)
     }
 }
 
@@ -194,6 +226,13 @@ pub fn decode_entry<T: DeserializeOwned>(
     check: impl FnOnce(&T) -> Result<(), String>,
 ) -> Result<T, String> {
     let payload = unframe(bytes, kind.magic(), key)?;
+    let inflated;
+    let payload = if kind.compressed() {
+        inflated = inflate(payload)?;
+        &inflated[..]
+    } else {
+        payload
+    };
     let (data, used): (T, usize) =
         decode_payload(payload).map_err(|e| format!("payload does not decode ({e})"))?;
     if used != payload.len() {
@@ -235,7 +274,58 @@ fn decode_payload<T: DeserializeOwned>(
 pub fn encode_entry<T: Serialize>(kind: EntryKind, key: &ShapeKey, value: &T) -> Vec<u8> {
     let payload = bincode::serde::encode_to_vec(value, bincode::config::standard())
         .expect("cached values are plain data and always encode");
+    let payload = if kind.compressed() {
+        deflate(&payload)
+    } else {
+        payload
+    };
     frame(kind.magic(), key, payload)
+}
+
+/// `length of raw (u64 LE) | raw deflated`.
+pub(crate) fn deflate(raw: &[u8]) -> Vec<u8> {
+    use flate2::{Compression, write::DeflateEncoder};
+    let header = (raw.len() as u64).to_le_bytes().to_vec();
+    let mut encoder = DeflateEncoder::new(header, Compression::new(DEFLATE_LEVEL));
+    encoder
+        .write_all(raw)
+        .expect("writing to memory cannot fail");
+    encoder.finish().expect("writing to memory cannot fail")
+}
+
+/// The raw bytes of a [`deflate`]d payload. A length that deflate cannot reach from this many
+/// bytes, a stream that does not inflate to exactly that length or leaves bytes unread, is
+/// refused, so no input makes it allocate more than [`MAX_INFLATE_RATIO`] × its size.
+pub(crate) fn inflate(stored: &[u8]) -> Result<Vec<u8>, String> {
+    use flate2::read::DeflateDecoder;
+    use std::io::Read;
+    let Some((len, body)) = stored.split_first_chunk::<8>() else {
+        return Err("compressed payload has no length".into());
+    };
+    let len = u64::from_le_bytes(*len);
+    if len > (body.len() as u64).saturating_mul(MAX_INFLATE_RATIO) {
+        return Err(format!(
+            "compressed payload of {} bytes claims {len} bytes",
+            body.len()
+        ));
+    }
+    let mut decoder = DeflateDecoder::new(body);
+    // Sized for what coseg writes (the band table deflates about 6:1); a stream that really
+    // expands more grows the vector as it goes.
+    let mut raw = Vec::with_capacity(len.min(body.len() as u64 * 16) as usize);
+    (&mut decoder)
+        .take(len + 1)
+        .read_to_end(&mut raw)
+        .map_err(|e| format!("compressed payload does not inflate ({e})"))?;
+    if raw.len() as u64 != len || decoder.total_in() != body.len() as u64 {
+        return Err(format!(
+            "compressed payload inflates to {} bytes from {} of its {} (header says {len})",
+            raw.len(),
+            decoder.total_in(),
+            body.len()
+        ));
+    }
+    Ok(raw)
 }
 
 /// Writes `bytes` (from [`encode_entry`]) to `path` atomically. The directory must exist.

@@ -54,7 +54,8 @@ pub struct ShapeEntry {
     pub key: ShapeKey,
     /// Number of vertices `d` of the mesh.
     pub vertices: usize,
-    /// Bytes of the full entry (`<key>.coseg-shape`: spectrum, descriptors, bands).
+    /// Bytes of the full entry (`<key>.coseg-shape`: f32 spectrum, band table, costly
+    /// feature columns).
     pub entry: Vec<u8>,
     /// Bytes of the compact entry (`<key>.coseg-bands`: band table and vertex areas).
     pub bands_entry: Vec<u8>,

@@ -467,3 +467,97 @@ fn segment_starts_records_the_choice_and_keeps_that_starts_regions() {
     ]);
     assert_ne!(bad.status.code(), Some(0));
 }
+
+/// The cache stores the `f32` spectrum and recomputes descriptors and bands on a warm load
+/// (issue #19's compact cache): a warm run must write the cold run's files byte for byte —
+/// `segment` (from the compact bands entries), `pair` (from the full entries, rebuilt), with
+/// another thread count, from a cache filled by the other command, and without any cache;
+/// `features --spectrum` writes the rebuilt descriptors and spectrum themselves, so that any
+/// difference at rounding level shows (the region files would hide it).
+#[test]
+fn warm_runs_write_the_cold_runs_files_byte_for_byte() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 3, 3);
+    let cache = dir.path().join("cache");
+    let run = |threads: &str, cmd: &[&str], out: &str, cache: Option<&Path>| {
+        let out = dir.path().join(out);
+        let mut args = vec!["--threads", threads];
+        args.extend(cmd);
+        args.extend(["-o", s(&out), "--no-pictures"]);
+        match cache {
+            Some(c) => args.extend(["--cache", s(c)]),
+            None if cmd[0] == "pair" => args.push("--no-cache"),
+            None => {}
+        }
+        args.extend(&FAST[..FAST.len() - 2]);
+        if cmd[0] == "segment" {
+            args.extend(&FAST[FAST.len() - 2..]);
+        } else {
+            args.extend(["--pairs", "3"]);
+        }
+        let r = coseg(&args);
+        assert_eq!(r.status.code(), Some(0), "{}", text(&r.stderr));
+        (files(&out), text(&r.stdout))
+    };
+    let same = |a: &[(String, Vec<u8>)], b: &[(String, Vec<u8>)], what: &str| {
+        assert_eq!(
+            a.iter().map(|f| &f.0).collect::<Vec<_>>(),
+            b.iter().map(|f| &f.0).collect::<Vec<_>>(),
+            "{what}"
+        );
+        for ((name, x), (_, y)) in a.iter().zip(b) {
+            assert!(x == y, "{what}: {name} differs");
+        }
+    };
+    let segment = ["segment", s(&input)];
+    let (cold, cold_out) = run("1", &segment, "seg-cold", Some(&cache));
+    assert!(cold_out.contains("(0 cached)"), "{cold_out}");
+    let (warm, warm_out) = run("2", &segment, "seg-warm", Some(&cache));
+    assert!(warm_out.contains("(3 cached)"), "{warm_out}");
+    same(&cold, &warm, "segment cold / warm");
+
+    let (a, b) = (input.join("s0.obj"), input.join("s1.off"));
+    let pair = ["pair", s(&a), s(&b)];
+    let pair_cache = dir.path().join("pair-cache");
+    let (cold, _) = run("1", &pair, "pair-cold", Some(&pair_cache));
+    let (warm, _) = run("2", &pair, "pair-warm", Some(&pair_cache));
+    same(&cold, &warm, "pair cold / warm");
+    // The full entries written by `segment` serve `pair` too.
+    let (from_segment, _) = run("1", &pair, "pair-from-segment", Some(&cache));
+    same(&cold, &from_segment, "pair cold / from segment's cache");
+    let (uncached, _) = run("3", &pair, "pair-uncached", None);
+    same(&cold, &uncached, "pair cold / no cache");
+    // pair read its two shapes from segment's cache: nothing was added.
+    assert_eq!(std::fs::read_dir(&cache).unwrap().count(), 6);
+
+    let features = |threads: &str, out: &str, cache: Option<&Path>| {
+        let out = dir.path().join(out);
+        let mut args = vec![
+            "--threads",
+            threads,
+            "features",
+            s(&a),
+            "-o",
+            s(&out),
+            "--spectrum",
+        ];
+        if let Some(c) = cache {
+            args.extend(["--cache", s(c)]);
+        }
+        args.extend(&FAST[..FAST.len() - 2]);
+        let r = coseg(&args);
+        assert_eq!(r.status.code(), Some(0), "{}", text(&r.stderr));
+        (files(&out), text(&r.stderr))
+    };
+    let feature_cache = dir.path().join("feature-cache");
+    let (cold, log) = features("1", "features-cold", Some(&feature_cache));
+    assert!(log.contains("cache miss"), "{log}");
+    assert!(cold.iter().any(|f| f.0 == "descriptors.npy"));
+    let (warm, log) = features("2", "features-warm", Some(&feature_cache));
+    assert!(log.contains("cache hit"), "{log}");
+    same(&cold, &warm, "features cold / warm");
+    let (uncached, _) = features("3", "features-uncached", None);
+    same(&cold, &uncached, "features cold / no cache");
+}

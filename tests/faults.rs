@@ -111,7 +111,8 @@ fn truncated_and_tampered_entries_are_never_trusted() {
     // A tampered payload with a recomputed checksum: the frame is valid, the content is not.
     let nan_entry = {
         let mut data = fresh.data.clone();
-        data.descriptors.values[3] = f64::NAN;
+        // (The full entry stores the spectrum, not the descriptors: cache format 4.)
+        data.spectrum.eigenvalues[3] = f64::NAN;
         encode_shape_entry(&data)
     };
     let cases: Vec<(&str, Vec<u8>, &str)> = vec![

@@ -35,7 +35,9 @@ fuzz_target!(|data: &[u8]| {
     if pick & 1 == 0 {
         if let Ok(d) = decode_shape_entry(&bytes, &key, vertices) {
             assert_eq!(d.vertices, vertices);
-            assert!(d.descriptors.values.iter().all(|x| x.is_finite()));
+            assert_eq!(d.eigenvectors.len(), vertices * d.eigenvalues.len());
+            assert!(d.eigenvectors.iter().all(|x| x.is_finite()));
+            assert!(d.kept_columns.values.iter().all(|x| x.is_finite()));
         }
     } else if let Ok(b) = decode_bands_entry(&bytes, &key, vertices) {
         assert_eq!(b.vertex_areas.len(), vertices);

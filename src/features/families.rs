@@ -108,20 +108,39 @@ impl FeatureFamilies {
     /// assert_eq!(cols.len(), 102);
     /// ```
     pub fn columns(&self, mesh: &TriMesh) -> Result<(FeatureColumns, [usize; 3]), FeatureError> {
+        let kept = self.kept_columns(mesh)?;
+        self.columns_with(mesh, kept)
+    }
+
+    /// The columns of the families the per-shape cache keeps rather than recomputes (sdf, then
+    /// user) and each one's count (`[sdf, user]`): the sdf casts rays (about 0.7 s per 10k
+    /// vertices) and the user file may have changed or gone by the next run, while the
+    /// extrinsic columns cost milliseconds. See [`crate::pipeline`] and [`crate::cache`].
+    ///
+    /// ```
+    /// use coseg::{mesh::TriMesh, features::{FeatureFamilies, ExtrinsicOptions}};
+    /// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[0.,1.,0.]], vec![[0,1,2]]).unwrap();
+    /// let mut f = FeatureFamilies::default();
+    /// f.extrinsic = Some(ExtrinsicOptions::default());
+    /// let (kept, counts) = f.kept_columns(&m).unwrap();
+    /// assert_eq!((kept.len(), counts), (0, [0, 0]));
+    /// assert_eq!(f.columns_with(&m, (kept, counts)).unwrap(), f.columns(&m).unwrap());
+    /// ```
+    pub fn kept_columns(
+        &self,
+        mesh: &TriMesh,
+    ) -> Result<(FeatureColumns, [usize; 2]), FeatureError> {
         let d = mesh.vertex_count();
         let mut names = Vec::new();
         let mut values = Vec::new();
-        let mut counts = [0usize; 3];
+        let mut counts = [0usize; 2];
         let mut push = |c: FeatureColumns, slot: usize| {
             counts[slot] = c.len();
             names.extend(c.names);
             values.extend(c.values);
         };
-        if let Some(o) = &self.extrinsic {
-            push(extrinsic_features(mesh, o)?, 0);
-        }
         if let Some(o) = &self.sdf {
-            push(shape_diameter(mesh, o)?, 1);
+            push(shape_diameter(mesh, o)?, 0);
         }
         match &self.user {
             None => {}
@@ -134,10 +153,42 @@ impl FeatureFamilies {
                 });
             }
             Some(UserSource::File { path, .. }) => {
-                push(sorted_by_name(read_user_features(path, d)?), 2)
+                push(sorted_by_name(read_user_features(path, d)?), 1)
             }
         }
         FeatureColumns::new(d, names, values).map(|c| (c, counts))
+    }
+
+    /// All the extra columns (extrinsic, then sdf, then user) and their counts, as
+    /// [`columns`](Self::columns) gives them, with the kept families' columns taken from
+    /// `kept` ([`kept_columns`](Self::kept_columns)'s result, computed now or read from a cache
+    /// entry) and the extrinsic ones computed.
+    pub fn columns_with(
+        &self,
+        mesh: &TriMesh,
+        kept: (FeatureColumns, [usize; 2]),
+    ) -> Result<(FeatureColumns, [usize; 3]), FeatureError> {
+        let d = mesh.vertex_count();
+        let (kept, [sdf, user]) = kept;
+        if kept.vertices != d || sdf + user != kept.len() {
+            return Err(FeatureError::Inconsistent(format!(
+                "{} kept columns on {} vertices ({sdf} sdf + {user} user) for a mesh of {d} \
+                 vertices",
+                kept.len(),
+                kept.vertices
+            )));
+        }
+        let (mut names, mut values, ext) = match &self.extrinsic {
+            Some(o) => {
+                let c = extrinsic_features(mesh, o)?;
+                let n = c.len();
+                (c.names, c.values, n)
+            }
+            None => (Vec::new(), Vec::new(), 0),
+        };
+        names.extend(kept.names);
+        values.extend(kept.values);
+        FeatureColumns::new(d, names, values).map(|c| (c, [ext, sdf, user]))
     }
 
     /// Per-column weights for a table of `spectral` spectral columns followed by

@@ -4,8 +4,8 @@
 use crate::bands::{BandError, BandOptions, BandTable, band_table};
 use crate::cache::{EntryKind, ShapeKey, decode_entry, encode_entry, entry_key};
 use crate::features::{
-    DescriptorOptions, Descriptors, FeatureError, FeatureFamilies, descriptors, parse_alignment,
-    parse_families, parse_family_weights,
+    DescriptorOptions, Descriptors, FeatureColumns, FeatureError, FeatureFamilies, descriptors,
+    parse_alignment, parse_families, parse_family_weights,
 };
 use crate::mesh::{MeshError, TriMesh};
 use crate::spectral::{
@@ -174,44 +174,178 @@ impl ShapeBands {
     }
 }
 
-impl ShapeData {
-    /// `Err(reason)` unless these data are keyed `key` and sized for a mesh of `vertices`
-    /// vertices (the check of a full cache entry before it is trusted).
+/// What the full cache entry holds (format version 4): the spectrum with its eigenvectors
+/// in `f32`, the columns of the families that are not cheap to recompute (sdf, user), and the
+/// band table (deflated). The rest of [`ShapeData`] (the spectral and extrinsic descriptors)
+/// is recomputed from it on a warm load by [`StoredShape::into_shape_data`], with the same
+/// code and the same inputs as on a cold run, hence the same bits: about 8.6 MB for 10k
+/// vertices and 200 eigenpairs instead of 43 MB (see [`crate::cache`]).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StoredShape {
+    /// The key these data were computed for (see [`shape_key`]).
+    pub key: ShapeKey,
+    /// Number of vertices `d` of the mesh.
+    pub vertices: usize,
+    /// [`Spectrum::eigenvalues`], exactly.
+    pub eigenvalues: Vec<f64>,
+    /// [`Spectrum::eigenvectors`] (`d × k`, column-major), which the pipeline rounds to `f32`
+    /// as soon as they are computed, so that narrowing here loses nothing.
+    pub eigenvectors: Vec<f32>,
+    /// [`Spectrum::vertex_areas`], exactly.
+    pub vertex_areas: Vec<f64>,
+    /// [`Spectrum::original_area`], exactly.
+    pub original_area: f64,
+    /// The kept families' columns ([`FeatureFamilies::kept_columns`]: sdf, then user) and
+    /// their counts `[sdf, user]`; no column when those families are off.
+    pub kept_columns: FeatureColumns,
+    /// How many of `kept_columns` each kept family gave: `[sdf, user]`.
+    pub kept_counts: [usize; 2],
+    /// [`ShapeData::bands`], exactly; its labels are deflated in the entry (about 6:1 on real
+    /// shapes). Recomputing it would be bit-identical too, but costs about as much as the
+    /// descriptors on a warm load (0.06 s for 10k vertices, 0.26 s for 52k), for 6 % of the
+    /// entry's size.
+    #[serde(with = "deflated_bands")]
+    pub bands: BandTable,
+}
+
+/// Serialises a [`BandTable`] with its labels deflated ([`crate::cache`]'s format, so a lying
+/// length is refused before anything is allocated).
+mod deflated_bands {
+    use crate::bands::BandTable;
+    use serde::{Deserialize, Deserializer, Serialize, Serializer, de::Error};
+
+    #[derive(Serialize, Deserialize)]
+    struct Packed {
+        features: usize,
+        vertices: usize,
+        bands: usize,
+        labels: Vec<u8>,
+    }
+
+    pub(super) fn serialize<S: Serializer>(t: &BandTable, s: S) -> Result<S::Ok, S::Error> {
+        Packed {
+            features: t.features,
+            vertices: t.vertices,
+            bands: t.bands,
+            labels: crate::cache::deflate(&t.labels),
+        }
+        .serialize(s)
+    }
+
+    pub(super) fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<BandTable, D::Error> {
+        let p = Packed::deserialize(d)?;
+        Ok(BandTable {
+            features: p.features,
+            vertices: p.vertices,
+            bands: p.bands,
+            labels: crate::cache::inflate(&p.labels).map_err(D::Error::custom)?,
+        })
+    }
+}
+
+impl StoredShape {
+    /// The stored part of `data`, which must come from [`compute_shape_data`] (or
+    /// [`shape_data_from_spectrum`]): its eigenvectors are then `f32` values and its last
+    /// descriptor columns the kept families'.
+    pub fn of(data: &ShapeData) -> Self {
+        let s = &data.spectrum;
+        debug_assert!(
+            s.eigenvectors.iter().all(|&x| f64::from(x as f32) == x),
+            "eigenvectors not rounded to f32: the entry would not reproduce the data"
+        );
+        let t = &data.descriptors;
+        let [ext, sdf, user] = t.family_counts;
+        let first = t.spectral_count() + ext;
+        let d = data.vertices;
+        Self {
+            key: data.key,
+            vertices: d,
+            eigenvalues: s.eigenvalues.clone(),
+            eigenvectors: s.eigenvectors.iter().map(|&x| x as f32).collect(),
+            vertex_areas: s.vertex_areas.clone(),
+            original_area: s.original_area,
+            kept_columns: FeatureColumns {
+                vertices: d,
+                names: t.extra_names[ext..].to_vec(),
+                values: t.values[first * d..].to_vec(),
+            },
+            kept_counts: [sdf, user],
+            bands: data.bands.clone(),
+        }
+    }
+
+    /// `Err(reason)` unless these data are keyed `key`, sized for a mesh of `vertices`
+    /// vertices and finite (the check of a full cache entry before it is trusted).
     pub(crate) fn check(&self, key: &ShapeKey, vertices: usize) -> Result<(), String> {
         if self.key != *key {
             return Err("payload key does not match".into());
         }
-        let n = self.descriptors.feature_count();
+        let k = self.eigenvalues.len();
+        let c = &self.kept_columns;
+        let t = &self.bands;
         let consistent = self.vertices == vertices
-            && self.spectrum.vertex_count() == vertices
-            && self.spectrum.eigenvectors.len() == vertices * self.spectrum.len()
-            && self.descriptors.vertices == vertices
-            && self.descriptors.values.len() == n * vertices
-            && self.bands.vertices == vertices
-            && self.bands.features == n
-            && self.bands.labels.len() == n * vertices
-            && self.spectrum.vertex_areas.len() == vertices
-            && self.descriptors.vertex_areas.len() == vertices
-            && self
-                .bands
-                .labels
-                .iter()
-                .all(|&l| (l as usize) < self.bands.bands);
+            && self.vertex_areas.len() == vertices
+            && Some(self.eigenvectors.len()) == vertices.checked_mul(k)
+            && c.vertices == vertices
+            && Some(c.values.len()) == vertices.checked_mul(c.names.len())
+            && self.kept_counts[0].checked_add(self.kept_counts[1]) == Some(c.names.len())
+            && t.vertices == vertices
+            && Some(t.labels.len()) == vertices.checked_mul(t.features)
+            && t.labels.iter().all(|&l| (l as usize) < t.bands);
         if !consistent {
             return Err("payload sizes do not match the mesh".into());
         }
         // A checksum only proves the bytes are the ones written; NaN must never come out of
         // the cache into a stage (or an output file), whoever wrote the entry.
         let finite = |x: &[f64]| x.iter().all(|v| v.is_finite());
-        if !(finite(&self.spectrum.eigenvalues)
-            && finite(&self.spectrum.eigenvectors)
-            && finite(&self.spectrum.vertex_areas)
-            && finite(&self.descriptors.values)
-            && finite(&self.descriptors.vertex_areas))
+        if !(finite(&self.eigenvalues)
+            && self.eigenvectors.iter().all(|v| v.is_finite())
+            && finite(&self.vertex_areas)
+            && self.original_area.is_finite()
+            && finite(&c.values))
         {
             return Err("payload holds non-finite numbers".into());
         }
         Ok(())
+    }
+
+    /// The shape's full data: the spectrum widened back to `f64` (the very values the cold
+    /// run used), then the descriptors computed from it exactly as
+    /// [`shape_data_from_spectrum`] does, with the kept columns and the band table taken
+    /// from the entry. `mesh` and `options` must be the ones the key was made from.
+    pub fn into_shape_data(
+        self,
+        mesh: &TriMesh,
+        options: &ShapePipelineOptions,
+    ) -> Result<ShapeData, PipelineError> {
+        let f = &options.families;
+        let sdf = f.sdf.as_ref().map_or(0, |s| s.smoothing_rounds.len());
+        let [kept_sdf, kept_user] = self.kept_counts;
+        if kept_sdf != sdf || (f.user.is_none() && kept_user != 0) {
+            return Err(FeatureError::Inconsistent(format!(
+                "the entry keeps {kept_sdf} sdf and {kept_user} user columns, the options ask \
+                 for {sdf} sdf columns{}",
+                if f.user.is_none() {
+                    " and no user ones"
+                } else {
+                    ""
+                }
+            ))
+            .into());
+        }
+        let spectrum = Spectrum {
+            eigenvalues: self.eigenvalues,
+            eigenvectors: self.eigenvectors.into_iter().map(f64::from).collect(),
+            vertex_areas: self.vertex_areas,
+            original_area: self.original_area,
+        };
+        assemble(
+            mesh,
+            spectrum,
+            (self.kept_columns, self.kept_counts),
+            Some(self.bands),
+            options,
+        )
     }
 }
 
@@ -229,9 +363,9 @@ pub fn shape_key(mesh: &TriMesh, options: &ShapePipelineOptions) -> ShapeKey {
     entry_key(mesh, options)
 }
 
-/// The bytes of the full cache entry of `data`.
+/// The bytes of the full cache entry of `data` ([`StoredShape::of`]).
 pub fn encode_shape_entry(data: &ShapeData) -> Vec<u8> {
-    encode_entry(EntryKind::Full, &data.key, data)
+    encode_entry(EntryKind::Full, &data.key, &StoredShape::of(data))
 }
 
 /// The bytes of the compact bands entry of `data`.
@@ -284,6 +418,7 @@ pub fn small_mesh_warning(mesh: &TriMesh, options: &ShapePipelineOptions) -> Opt
 /// Verifies and decodes the bytes of a full cache entry written for `key` on a mesh of
 /// `vertices` vertices; `Err` says why it cannot be trusted (frame, decoding, sizes,
 /// non-finite numbers: see [`crate::cache::read_entry`]). Never panics, whatever the bytes.
+/// [`StoredShape::into_shape_data`] turns the result into the shape's full data.
 ///
 /// ```
 /// use coseg::mesh::TriMesh;
@@ -294,7 +429,8 @@ pub fn small_mesh_warning(mesh: &TriMesh, options: &ShapePipelineOptions) -> Opt
 /// o.bands.bands = 2;
 /// let data = compute_shape_data(&m, &o).unwrap();
 /// let mut bytes = encode_shape_entry(&data);
-/// assert_eq!(decode_shape_entry(&bytes, &data.key, 4).unwrap(), data);
+/// let stored = decode_shape_entry(&bytes, &data.key, 4).unwrap();
+/// assert_eq!(stored.into_shape_data(&m, &o).unwrap(), data);
 /// *bytes.last_mut().unwrap() ^= 1; // one flipped bit: the checksum no longer matches
 /// assert!(decode_shape_entry(&bytes, &data.key, 4).unwrap_err().contains("checksum"));
 /// ```
@@ -302,8 +438,8 @@ pub fn decode_shape_entry(
     bytes: &[u8],
     key: &ShapeKey,
     vertices: usize,
-) -> Result<ShapeData, String> {
-    decode_entry(bytes, EntryKind::Full, key, |d: &ShapeData| {
+) -> Result<StoredShape, String> {
+    decode_entry(bytes, EntryKind::Full, key, |d: &StoredShape| {
         d.check(key, vertices)
     })
 }
@@ -333,17 +469,59 @@ pub fn decode_bands_entry(
 /// Descriptors and band table from an already computed spectrum (e.g. read elsewhere), keyed
 /// as [`compute_shape_data`] would key them. The spectrum must be the one
 /// `options.spectrum` gives for `mesh`, or the cache key would lie.
+///
+/// The eigenvectors are rounded to `f32` first (widened back to `f64`): the full cache entry
+/// stores them in `f32` ([`StoredShape`]), and rounding here, before anything uses them, makes
+/// every result of a cold run bit-identical to the same result recomputed from the entry on a
+/// warm run. The rounding (relative 6·10⁻⁸) is far below the solver's own accuracy on
+/// eigenvectors; its effect on quality is measured in `docs/PERFORMANCE.md` (Compact cache).
 pub fn shape_data_from_spectrum(
     mesh: &TriMesh,
+    mut spectrum: Spectrum,
+    options: &ShapePipelineOptions,
+) -> Result<ShapeData, PipelineError> {
+    round_to_f32(&mut spectrum.eigenvectors);
+    let kept = options.families.kept_columns(mesh)?;
+    assemble(mesh, spectrum, kept, None, options)
+}
+
+/// Rounds every value to the nearest `f32` (kept as `f64`).
+fn round_to_f32(values: &mut [f64]) {
+    for x in values {
+        *x = f64::from(*x as f32);
+    }
+}
+
+/// The one place both a cold run ([`shape_data_from_spectrum`]) and a warm load
+/// ([`StoredShape::into_shape_data`]) build a shape's data from its spectrum and its kept
+/// columns, so that both give the same bits. `bands`: the stored band table (warm), or `None`
+/// to compute it (cold).
+fn assemble(
+    mesh: &TriMesh,
     spectrum: Spectrum,
+    kept: (FeatureColumns, [usize; 2]),
+    bands: Option<BandTable>,
     options: &ShapePipelineOptions,
 ) -> Result<ShapeData, PipelineError> {
     let mut descriptors = descriptors(mesh, &spectrum, &options.descriptors)?;
     if options.families != FeatureFamilies::default() {
-        let (extra, counts) = options.families.columns(mesh)?;
+        let (extra, counts) = options.families.columns_with(mesh, kept)?;
         descriptors.append(extra, counts)?;
     }
-    let bands = band_table(&descriptors, &options.bands)?;
+    let bands = match bands {
+        None => band_table(&descriptors, &options.bands)?,
+        Some(t) if t.features == descriptors.feature_count() && t.bands == options.bands.bands => t,
+        Some(t) => {
+            return Err(FeatureError::Inconsistent(format!(
+                "a stored band table of {} features and {} bands for {} features and {} bands",
+                t.features,
+                t.bands,
+                descriptors.feature_count(),
+                options.bands.bands
+            ))
+            .into());
+        }
+    };
     Ok(ShapeData {
         key: shape_key(mesh, options),
         vertices: mesh.vertex_count(),
