@@ -35,7 +35,7 @@ timed() {
   t=$(mktemp)
   local o
   o=$(/usr/bin/time -f "%e,%U,%S,%M" -o "$t" "$@")
-  echo "$l,$(cat "$t"),$o"
+  echo "$l,$(cat "$t")${o:+,$o}"
   rm -f "$t"
 }
 

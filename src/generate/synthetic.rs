@@ -30,6 +30,35 @@ impl SplitMix64 {
     }
 }
 
+/// The stream behind [`smooth_features`]: random points of the unit square, then one feature
+/// at a time.
+struct SmoothStream {
+    random: SplitMix64,
+    points: Vec<(f64, f64)>,
+}
+
+impl SmoothStream {
+    fn new(vertices: usize, seed: u64) -> Self {
+        let mut random = SplitMix64(seed);
+        let points = (0..vertices)
+            .map(|_| (random.next_f64(), random.next_f64()))
+            .collect();
+        SmoothStream { random, points }
+    }
+
+    /// Appends the next feature's value at every point to `out`.
+    fn next_feature(&mut self, out: &mut Vec<f64>) {
+        let r = &mut self.random;
+        let (a, b) = (r.next_f64() - 0.5, r.next_f64() - 0.5);
+        let f = 1.0 + 6.0 * r.next_f64();
+        out.extend(
+            self.points
+                .iter()
+                .map(|&(x, y)| (f * (a * x + b * y)).sin()),
+        );
+    }
+}
+
 /// `features` smooth pseudo-features of `vertices` random points of the unit square, feature-
 /// major (`values[k * vertices + v]`, the layout of [`equal_count_bands`]): feature `k` is
 /// `sin(f_k (a_k x + b_k y))` with a random direction `(a_k, b_k)` and frequency `f_k ∈ [1, 7)`.
@@ -41,25 +70,27 @@ impl SplitMix64 {
 /// assert!(v.iter().all(|x| x.abs() <= 1.0));
 /// ```
 pub fn smooth_features(vertices: usize, features: usize, seed: u64) -> Vec<f64> {
-    let mut r = SplitMix64(seed);
-    let points: Vec<(f64, f64)> = (0..vertices)
-        .map(|_| (r.next_f64(), r.next_f64()))
-        .collect();
+    let mut stream = SmoothStream::new(vertices, seed);
     let mut values = Vec::with_capacity(vertices * features);
     for _ in 0..features {
-        let (a, b) = (r.next_f64() - 0.5, r.next_f64() - 0.5);
-        let f = 1.0 + 6.0 * r.next_f64();
-        values.extend(points.iter().map(|&(x, y)| (f * (a * x + b * y)).sin()));
+        stream.next_feature(&mut values);
     }
     values
 }
 
-/// The equal-count band table of [`smooth_features`]: a `features × vertices` table with
-/// `bands` bands, as the per-shape pipeline would make from descriptors.
+/// The equal-count band table of [`smooth_features`] (the same labels as
+/// `equal_count_bands(&smooth_features(vertices, features, seed), features, vertices, bands)`):
+/// a `features × vertices` table with `bands` bands, as the per-shape pipeline would make from
+/// descriptors. Features are made and banded one at a time, so beyond the table only one
+/// feature's values are held (the scaling study measures the operator's memory, not this).
 ///
 /// ```
-/// let t = coseg::generate::synthetic_band_table(1000, 10, 20, 1).unwrap();
+/// use coseg::bands::equal_count_bands;
+/// use coseg::generate::{smooth_features, synthetic_band_table};
+/// let t = synthetic_band_table(1000, 10, 20, 1).unwrap();
 /// assert_eq!((t.features, t.vertices), (10, 1000));
+/// let all_at_once = equal_count_bands(&smooth_features(1000, 10, 1), 10, 1000, 20).unwrap();
+/// assert_eq!(t, all_at_once);
 /// ```
 pub fn synthetic_band_table(
     vertices: usize,
@@ -67,12 +98,28 @@ pub fn synthetic_band_table(
     bands: usize,
     seed: u64,
 ) -> Result<BandTable, BandError> {
-    equal_count_bands(
-        &smooth_features(vertices, features, seed),
-        features,
-        vertices,
-        bands,
-    )
+    let mut stream = SmoothStream::new(vertices, seed);
+    let mut labels = vec![0u8; vertices * features];
+    let mut column = Vec::with_capacity(vertices);
+    let mut table = None;
+    for k in 0..features {
+        column.clear();
+        stream.next_feature(&mut column);
+        let one = equal_count_bands(&column, 1, vertices, bands)?;
+        for (v, &l) in one.labels.iter().enumerate() {
+            labels[v * features + k] = l;
+        }
+        table = Some(one);
+    }
+    match table {
+        Some(one) => Ok(BandTable {
+            features,
+            labels,
+            ..one
+        }),
+        // No features: whatever `equal_count_bands` says of an empty table.
+        None => equal_count_bands(&[], 0, vertices, bands),
+    }
 }
 
 /// An `n × n` grid of unit squares (`n ≥ 2` points a side), each cut into two triangles,
