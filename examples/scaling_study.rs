@@ -15,7 +15,8 @@
 //! of the fastest run (all threads of the process, from `/proc/self/task/*/schedstat`, ns), the
 //! bytes of the two tables, the resident size once the tables are built and the peak resident
 //! size while the operator is built and applied (`VmHWM` after resetting it by writing 5 to
-//! `/proc/self/clear_refs`, so the generation of the f64 pseudo-features does not count).
+//! `/proc/self/clear_refs`, so the making of the tables does not count) and, for `alg2`, the
+//! regions found and the Algorithm-1 rounds they took.
 //! `refine`: writes the mesh refined by `coseg::generate::refine_mesh` (each triangle into N²)
 //! to `OUT.obj` and prints the vertex counts.
 
@@ -78,7 +79,7 @@ fn main() -> anyhow::Result<()> {
     match arg(0)? {
         "header" => {
             println!(
-                "kind,vertices,features,table_bytes,wall_min_s,wall_median_s,cpu_s,rss_tables_kb,hwm_kb,threads,regions"
+                "kind,vertices,features,table_bytes,wall_min_s,wall_median_s,cpu_s,rss_tables_kb,hwm_kb,threads,regions,rounds"
             );
         }
         "refine" => {
@@ -103,26 +104,26 @@ fn main() -> anyhow::Result<()> {
             let rss_tables = status_kb("VmRSS:");
             std::fs::write("/proc/self/clear_refs", "5")?;
             let w = BandAffinity::new(&ta, &tb)?;
-            let (best, median, cpu, regions) = if kind == "wx" {
+            let (best, median, cpu, (regions, rounds)) = if kind == "wx" {
                 let mut ws = w.workspace();
                 let x: Vec<f64> = (0..vertices).map(|p| (p % 17) as f64 + 0.5).collect();
                 let mut out = vec![0.0; vertices];
                 let (b, m, c) = timed(repeats, || {
                     w.apply(&x, &mut out, &mut ws).expect("sizes match");
                 });
-                (b, m, c, 0)
+                (b, m, c, (0, 0))
             } else {
                 let areas = vec![1.0 / vertices as f64; vertices];
                 let options = StableRegionsOptions::default();
-                let mut regions = 0;
+                let mut found = (0, 0);
                 let (b, m, c) = timed(repeats, || {
                     let r = stable_pairs_fixed(&w, &areas, &areas, &options).expect("runs");
-                    regions = r.pairs.len();
+                    found = (r.pairs.len(), r.pairs.iter().map(|p| p.iterations).sum());
                 });
-                (b, m, c, regions)
+                (b, m, c, found)
             };
             println!(
-                "{kind},{vertices},{features},{},{best:.6},{median:.6},{cpu:.6},{rss_tables},{},{},{regions}",
+                "{kind},{vertices},{features},{},{best:.6},{median:.6},{cpu:.6},{rss_tables},{},{},{regions},{rounds}",
                 ta.labels.len() + tb.labels.len(),
                 status_kb("VmHWM:"),
                 rayon::current_num_threads()
