@@ -64,8 +64,8 @@ for s in "${sections[@]}"; do
     for n in $PAIR_LEVELS; do
       d=$OUT/pair/n$n
       mkdir -p "$d"
-      for s in 41 181; do
-        [ -f "$d/q$s.obj" ] || $study refine "$shapes/quadrupeds_$s.obj" "$n" "$d/q$s.obj" >/dev/null
+      for i in 41 181; do
+        [ -f "$d/q$i.obj" ] || $study refine "$shapes/quadrupeds_$i.obj" "$n" "$d/q$i.obj" >/dev/null
       done
       va=$(grep -c '^v ' "$d/q41.obj")
       vb=$(grep -c '^v ' "$d/q181.obj")
@@ -80,7 +80,8 @@ for s in "${sections[@]}"; do
     ;;
   segment)
     # The first N generated quadrupeds; one cache shared by every N (a shape's entry does not
-    # depend on the collection), filled by a cold run on all of them; warm runs are measured.
+    # depend on the collection). Each N runs twice: the first fills the cache with the shapes
+    # not yet in it, the second (warm) is measured.
     csv=$OUT/segment.csv
     echo "load1,wall_s,user_s,sys_s,max_rss_kb,shapes,total_vertices" >"$csv"
     cache=$OUT/segment-cache
