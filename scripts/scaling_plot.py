@@ -109,7 +109,7 @@ def main():
     for a in ax.flat:
         a.grid(True, which="both", lw=0.3)
         if a.lines:
-            a.legend(fontsize=7, loc="upper left")
+            a.legend(fontsize=7, loc="lower right")
     fig.suptitle("coseg scaling study (docs/SCALING.md); dotted: log-log least-squares fits", fontsize=10)
     fig.tight_layout()
     fig.savefig(png, dpi=72)
