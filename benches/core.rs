@@ -11,11 +11,10 @@
 //! ```
 
 use coseg::affinity::{BandAffinity, Direction};
-use coseg::bands::BandTable;
+use coseg::bands::{BandTable, synthetic_band_table};
 use coseg::features::{DescriptorOptions, descriptors};
 use coseg::generate::{
     Family, GenerateOptions, SplitMix64, generate_family, grid_mesh, smooth_features,
-    synthetic_band_table,
 };
 use coseg::graph::{
     CosegmentOptions, CycleShape, CycleStep, GraphOptions, ShapeGraph, ShapeNode,

@@ -8,7 +8,7 @@
 //! cargo run --release --example scaling_study -- header
 //! ```
 //! `wx`: one `W·x` (the band-affinity apply, f64 `x` on every vertex of A) between two seeded
-//! synthetic band tables (`coseg::generate::synthetic_band_table`, 20 bands, no spectrum) of
+//! synthetic band tables (`coseg::bands::synthetic_band_table`, 20 bands, no spectrum) of
 //! `VERTICES` vertices and `FEATURES` features each; `alg2`: one Algorithm 2 (defaults: 10 %
 //! area cutoff, 10 pairs, uniform areas) on the same tables. Each is run `R` times (default 20
 //! for `wx`, 3 for `alg2`); the line gives the fastest and the median wall time, the CPU time
@@ -21,7 +21,8 @@
 //! to `OUT.obj` and prints the vertex counts.
 
 use coseg::affinity::BandAffinity;
-use coseg::generate::{refine_mesh, synthetic_band_table};
+use coseg::bands::synthetic_band_table;
+use coseg::generate::refine_mesh;
 use coseg::mesh::{read_mesh, write_mesh};
 use coseg::stable::{StableRegionsOptions, stable_pairs_fixed};
 use std::time::Instant;

@@ -10,8 +10,9 @@
 //! same bytes on every platform.
 //!
 //! Also seeded synthetic inputs for benchmarks and scaling studies, without any spectrum:
-//! smooth pseudo-features and their band tables ([`synthetic_band_table`]), a bent grid
-//! ([`grid_mesh`]) and a finer copy of a mesh ([`refine_mesh`]).
+//! smooth pseudo-features ([`smooth_features`], banded by
+//! [`crate::bands::synthetic_band_table`]), a bent grid ([`grid_mesh`]) and a finer copy of a
+//! mesh ([`refine_mesh`]).
 //!
 //! ```
 //! use coseg::generate::{generate_family, Family, GenerateOptions};
@@ -33,7 +34,7 @@ mod write_collection;
 
 pub use generate_family::{GenerateOptions, generate_family};
 pub use marching_tetrahedra::{ScalarGrid, marching_tetrahedra};
-pub use synthetic::{SplitMix64, grid_mesh, refine_mesh, smooth_features, synthetic_band_table};
+pub use synthetic::{SmoothFeatures, SplitMix64, grid_mesh, refine_mesh, smooth_features};
 pub use write_collection::{MANIFEST_FORMAT, Manifest, ManifestShape, obj_text, write_collection};
 
 use crate::mesh::TriMesh;

@@ -1,9 +1,9 @@
 //! Seeded synthetic inputs for benchmarks and scaling studies (`benches/core.rs`,
-//! `examples/scaling_study.rs`): smooth pseudo-features and their band tables without any
-//! spectrum, a bent grid, and a finer copy of a mesh. Deterministic: the same arguments give
-//! the same values on every platform (integer arithmetic for the random stream).
+//! `examples/scaling_study.rs`): smooth pseudo-features without any spectrum (banded by
+//! [`crate::bands::synthetic_band_table`]), a bent grid, and a finer copy of a mesh.
+//! Deterministic: the same arguments give the same values on every platform (integer
+//! arithmetic for the random stream).
 
-use crate::bands::{BandError, BandTable, equal_count_bands};
 use crate::mesh::{MeshError, TriMesh};
 use std::collections::HashMap;
 
@@ -30,39 +30,62 @@ impl SplitMix64 {
     }
 }
 
-/// The stream behind [`smooth_features`]: random points of the unit square, then one feature
-/// at a time.
-struct SmoothStream {
+/// The smooth pseudo-features of [`smooth_features`], one feature (a `Vec` of one value per
+/// point) at a time, so that a caller can use them without holding them all (the band table of
+/// [`crate::bands::synthetic_band_table`] does).
+///
+/// ```
+/// use coseg::generate::{SmoothFeatures, smooth_features};
+/// let one_by_one: Vec<f64> = SmoothFeatures::new(50, 4, 3).flatten().collect();
+/// assert_eq!(one_by_one, smooth_features(50, 4, 3));
+/// ```
+#[derive(Debug, Clone)]
+pub struct SmoothFeatures {
     random: SplitMix64,
     points: Vec<(f64, f64)>,
+    remaining: usize,
 }
 
-impl SmoothStream {
-    fn new(vertices: usize, seed: u64) -> Self {
+impl SmoothFeatures {
+    /// `features` features of `vertices` random points of the unit square, from `seed`.
+    pub fn new(vertices: usize, features: usize, seed: u64) -> Self {
         let mut random = SplitMix64(seed);
         let points = (0..vertices)
             .map(|_| (random.next_f64(), random.next_f64()))
             .collect();
-        SmoothStream { random, points }
+        SmoothFeatures {
+            random,
+            points,
+            remaining: features,
+        }
     }
+}
 
-    /// Appends the next feature's value at every point to `out`.
-    fn next_feature(&mut self, out: &mut Vec<f64>) {
+impl Iterator for SmoothFeatures {
+    type Item = Vec<f64>;
+
+    fn next(&mut self) -> Option<Vec<f64>> {
+        if self.remaining == 0 {
+            return None;
+        }
+        self.remaining -= 1;
         let r = &mut self.random;
         let (a, b) = (r.next_f64() - 0.5, r.next_f64() - 0.5);
         let f = 1.0 + 6.0 * r.next_f64();
-        out.extend(
+        Some(
             self.points
                 .iter()
-                .map(|&(x, y)| (f * (a * x + b * y)).sin()),
-        );
+                .map(|&(x, y)| (f * (a * x + b * y)).sin())
+                .collect(),
+        )
     }
 }
 
 /// `features` smooth pseudo-features of `vertices` random points of the unit square, feature-
-/// major (`values[k * vertices + v]`, the layout of [`equal_count_bands`]): feature `k` is
-/// `sin(f_k (a_k x + b_k y))` with a random direction `(a_k, b_k)` and frequency `f_k ∈ [1, 7)`.
-/// Like spectral descriptors, nearby points have nearby values and features are correlated.
+/// major (`values[k * vertices + v]`, the layout of [`crate::bands::equal_count_bands`]):
+/// feature `k` is `sin(f_k (a_k x + b_k y))` with a random direction `(a_k, b_k)` and frequency
+/// `f_k ∈ [1, 7)`. Like spectral descriptors, nearby points have nearby values and features are
+/// correlated.
 ///
 /// ```
 /// let v = coseg::generate::smooth_features(100, 3, 1);
@@ -70,56 +93,9 @@ impl SmoothStream {
 /// assert!(v.iter().all(|x| x.abs() <= 1.0));
 /// ```
 pub fn smooth_features(vertices: usize, features: usize, seed: u64) -> Vec<f64> {
-    let mut stream = SmoothStream::new(vertices, seed);
-    let mut values = Vec::with_capacity(vertices * features);
-    for _ in 0..features {
-        stream.next_feature(&mut values);
-    }
-    values
-}
-
-/// The equal-count band table of [`smooth_features`] (the same labels as
-/// `equal_count_bands(&smooth_features(vertices, features, seed), features, vertices, bands)`):
-/// a `features × vertices` table with `bands` bands, as the per-shape pipeline would make from
-/// descriptors. Features are made and banded one at a time, so beyond the table only one
-/// feature's values are held (the scaling study measures the operator's memory, not this).
-///
-/// ```
-/// use coseg::bands::equal_count_bands;
-/// use coseg::generate::{smooth_features, synthetic_band_table};
-/// let t = synthetic_band_table(1000, 10, 20, 1).unwrap();
-/// assert_eq!((t.features, t.vertices), (10, 1000));
-/// let all_at_once = equal_count_bands(&smooth_features(1000, 10, 1), 10, 1000, 20).unwrap();
-/// assert_eq!(t, all_at_once);
-/// ```
-pub fn synthetic_band_table(
-    vertices: usize,
-    features: usize,
-    bands: usize,
-    seed: u64,
-) -> Result<BandTable, BandError> {
-    let mut stream = SmoothStream::new(vertices, seed);
-    let mut labels = vec![0u8; vertices * features];
-    let mut column = Vec::with_capacity(vertices);
-    let mut table = None;
-    for k in 0..features {
-        column.clear();
-        stream.next_feature(&mut column);
-        let one = equal_count_bands(&column, 1, vertices, bands)?;
-        for (v, &l) in one.labels.iter().enumerate() {
-            labels[v * features + k] = l;
-        }
-        table = Some(one);
-    }
-    match table {
-        Some(one) => Ok(BandTable {
-            features,
-            labels,
-            ..one
-        }),
-        // No features: whatever `equal_count_bands` says of an empty table.
-        None => equal_count_bands(&[], 0, vertices, bands),
-    }
+    SmoothFeatures::new(vertices, features, seed)
+        .flatten()
+        .collect()
 }
 
 /// An `n × n` grid of unit squares (`n ≥ 2` points a side), each cut into two triangles,
