@@ -1,67 +1,43 @@
-//! Criterion benchmarks of the kernels a pair runs, on seeded generated inputs (no data files):
-//! the band-affinity product `W·x` at several sizes and feature counts, Algorithm 2, the
-//! spectrum, ZoomOut and the auction of its last match.
+//! Criterion benchmarks of the kernels a pair and a collection run, on seeded generated inputs
+//! (no data files; `coseg::generate`'s synthetic band tables, grid and shape families): the
+//! band-affinity product `W·x` at several sizes and feature counts, Algorithms 1, 2 and 3, the
+//! stable cycle over 3 shapes, the co-segmentation sweep of a generated collection, the
+//! spectrum, the descriptors (HKS, WKS, curvature), ZoomOut, the clustered candidate search of
+//! the last match and its auction.
 //!
 //! ```text
-//! cargo bench --bench core            # all, ~1 min
+//! cargo bench --bench core            # all, ~3 min
 //! cargo bench --bench core -- affinity
 //! ```
 
-use coseg::affinity::BandAffinity;
-use coseg::bands::{BandTable, equal_count_bands};
-use coseg::maps::{
-    AuctionOptions, CandidateLists, ShapeGeometry, ZoomOutOptions, auction_assignment, zoomout,
+use coseg::affinity::{BandAffinity, Direction};
+use coseg::bands::{BandTable, synthetic_band_table};
+use coseg::features::{DescriptorOptions, descriptors};
+use coseg::generate::{
+    Family, GenerateOptions, SplitMix64, generate_family, grid_mesh, smooth_features,
 };
-use coseg::mesh::TriMesh;
+use coseg::graph::{
+    CosegmentOptions, CycleShape, CycleStep, GraphOptions, ShapeGraph, ShapeNode,
+    StableCycleOptions, cosegment, stable_cycle,
+};
+use coseg::maps::{
+    AuctionOptions, CandidateLists, ShapeGeometry, ZoomOutOptions, auction_assignment,
+    nearest_candidates, zoomout,
+};
+use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
-use coseg::stable::{StableRegionsOptions, stable_pairs_fixed};
+use coseg::stable::{
+    Algorithm, Remaining, StablePairOptions, StableRegionsOptions, Threshold, stable_pair,
+    stable_pairs_auto, stable_pairs_fixed,
+};
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use faer::Mat;
 use std::hint::black_box;
 use std::time::Duration;
 
-/// A deterministic stream of numbers in [0, 1) (SplitMix64).
-struct Seeded(u64);
-
-impl Seeded {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
-/// A `features × vertices` band table of smooth random features (sines of random
-/// projections of points on a unit square) with 20 bands.
+/// The synthetic `features × vertices` band table of the benchmarks (20 bands).
 fn table(vertices: usize, features: usize, seed: u64) -> BandTable {
-    let mut r = Seeded(seed);
-    let points: Vec<(f64, f64)> = (0..vertices).map(|_| (r.next(), r.next())).collect();
-    let mut values = Vec::with_capacity(vertices * features);
-    for _ in 0..features {
-        let (a, b, f) = (r.next() - 0.5, r.next() - 0.5, 1.0 + 6.0 * r.next());
-        values.extend(points.iter().map(|&(x, y)| (f * (a * x + b * y)).sin()));
-    }
-    equal_count_bands(&values, features, vertices, 20).expect("finite features")
-}
-
-/// An `n × n` grid of unit squares, each cut into two triangles, gently bent.
-fn grid(n: u32) -> TriMesh {
-    let pos = (0..n * n)
-        .map(|i| {
-            let (x, y) = ((i % n) as f64, (i / n) as f64);
-            [x, y, 0.1 * (x * 0.3).sin() * (y * 0.2).cos()]
-        })
-        .collect();
-    let mut faces = Vec::new();
-    for y in 0..n - 1 {
-        for x in 0..n - 1 {
-            let v = y * n + x;
-            faces.push([v, v + 1, v + n + 1]);
-            faces.push([v, v + n + 1, v + n]);
-        }
-    }
-    TriMesh::new(pos, faces).expect("a valid grid")
+    synthetic_band_table(vertices, features, 20, seed).expect("finite features")
 }
 
 fn affinity(c: &mut Criterion) {
@@ -85,18 +61,104 @@ fn affinity(c: &mut Criterion) {
     g.finish();
 }
 
-fn algorithm_2(c: &mut Criterion) {
-    let (ta, tb) = (table(5_000, 50, 3), table(5_000, 50, 4));
+/// Algorithms 1, 2 and 3 between two synthetic 5,000-vertex shapes with 50 features, and the
+/// stable cycle through a third.
+fn pair_algorithms(c: &mut Criterion) {
+    let n = 5_000;
+    let (ta, tb, tc) = (table(n, 50, 3), table(n, 50, 4), table(n, 50, 6));
     let w = BandAffinity::new(&ta, &tb).expect("equal feature counts");
-    let areas = vec![1.0 / 5_000.0; 5_000];
+    let areas = vec![1.0 / n as f64; n];
+    let all: Vec<u32> = (0..n as u32).collect();
+    let remaining = Remaining {
+        vertices_a: &all,
+        vertices_b: &all,
+        areas_a: &areas,
+        areas_b: &areas,
+        reference_area_a: 1.0,
+        reference_area_b: 1.0,
+    };
+    // Algorithm 1 from the first 10 % of A (α = 0.1 on both sides).
+    let f0: Vec<u32> = (0..n as u32 / 10).collect();
+    let options = StablePairOptions::default();
+    c.bench_function("algorithm_1/5000v_50f", |b| {
+        b.iter(|| stable_pair(&w, &remaining, black_box(&f0), &options).expect("runs"))
+    });
     let options = StableRegionsOptions::default();
     c.bench_function("algorithm_2/5000v_50f", |b| {
         b.iter(|| stable_pairs_fixed(&w, &areas, &areas, black_box(&options)).expect("runs"))
     });
+    let options = {
+        let mut opts = StableRegionsOptions::default();
+        opts.algorithm = Algorithm::Auto;
+        opts
+    };
+    c.bench_function("algorithm_3/5000v_50f", |b| {
+        b.iter(|| stable_pairs_auto(&w, &areas, &areas, black_box(&options)).expect("runs"))
+    });
+    // The cycle A → B → C → A with α = 0.1 on every shape.
+    let (wbc, wca) = (
+        BandAffinity::new(&tb, &tc).expect("equal feature counts"),
+        BandAffinity::new(&tc, &ta).expect("equal feature counts"),
+    );
+    let shape = CycleShape {
+        remaining: &all,
+        areas: &areas,
+        reference_area: 1.0,
+        rule: Threshold::AreaFraction(0.1),
+    };
+    let steps = [&w, &wbc, &wca].map(|affinity| CycleStep {
+        affinity,
+        direction: Direction::AtoB,
+    });
+    let options = StableCycleOptions::default();
+    c.bench_function("stable_cycle/3x5000v_50f", |b| {
+        b.iter(|| stable_cycle(&[shape; 3], &steps, black_box(&f0), &options).expect("runs"))
+    });
+}
+
+/// The co-segmentation sweep (`cosegment`, 6 regions) of 4 generated quadrupeds (per-shape data
+/// with 40 eigenpairs, computed once outside the timing).
+fn cosegmentation(c: &mut Criterion) {
+    let collection = generate_family(Family::Quadrupeds, &{
+        let mut opts = GenerateOptions::default();
+        opts.count = 4;
+        opts
+    })
+    .expect("generates");
+    let mut pipeline = ShapePipelineOptions::default();
+    pipeline.spectrum.eigenpairs = 40;
+    let nodes: Vec<ShapeNode> = collection
+        .shapes
+        .iter()
+        .map(|s| {
+            let data = compute_shape_data(&s.mesh, &pipeline).expect("per-shape data");
+            ShapeNode::new(s.name.clone(), data.bands, &s.mesh.vertex_areas()).expect("a node")
+        })
+        .collect();
+    let vertices: usize = nodes.iter().map(|n| n.bands.vertices).sum();
+    let graph = ShapeGraph::build(nodes, &GraphOptions::default()).expect("a graph");
+    let options = CosegmentOptions::default();
+    c.bench_function(&format!("cosegment/4_quadrupeds_{vertices}v"), |b| {
+        b.iter(|| cosegment(&graph, black_box(&options)).expect("runs"))
+    });
+}
+
+/// The last match's clustered candidate search (`nearest_candidates`, used from 8,192 base rows):
+/// 10,000 query rows against 10,000 base rows of 60 smooth columns, 64 candidates each.
+fn candidate_search(c: &mut Criterion) {
+    let (rows, columns) = (10_000, 60);
+    // Both row sets sample the same smooth functions at different random points.
+    let values = smooth_features(2 * rows, columns, 7);
+    let half =
+        |offset: usize| Mat::from_fn(rows, columns, |i, j| values[j * 2 * rows + offset + i]);
+    let (base, query) = (half(0), half(rows));
+    c.bench_function("nearest_candidates/10000x10000_60d_64c", |b| {
+        b.iter(|| nearest_candidates(base.as_ref(), black_box(query.as_ref()), 64))
+    });
 }
 
 fn spectrum_and_map(c: &mut Criterion) {
-    let mesh = grid(50);
+    let mesh = grid_mesh(50).expect("a valid grid");
     let options = {
         let mut opts = SpectrumOptions::default();
         opts.eigenpairs = 40;
@@ -106,6 +168,10 @@ fn spectrum_and_map(c: &mut Criterion) {
         b.iter(|| laplace_beltrami_spectrum(black_box(&mesh), &options).expect("solves"))
     });
     let spectrum = laplace_beltrami_spectrum(&mesh, &options).expect("solves");
+    let features = DescriptorOptions::default();
+    c.bench_function("descriptors/2500v_k40_300f", |b| {
+        b.iter(|| descriptors(&mesh, black_box(&spectrum), &features).expect("computes"))
+    });
     let shape = ShapeGeometry {
         spectrum: &spectrum,
         positions: mesh.positions(),
@@ -122,17 +188,17 @@ fn spectrum_and_map(c: &mut Criterion) {
         b.iter(|| zoomout(shape, shape, black_box(&start), &zo).expect("runs"))
     });
     // The auction alone on candidate lists like ZoomOut's: 20,000 queries, 16 candidates.
-    let mut r = Seeded(5);
+    let mut r = SplitMix64(5);
     let (queries, per_query) = (20_000usize, 16usize);
     let mut targets = Vec::with_capacity(queries * per_query);
     let mut costs = Vec::with_capacity(queries * per_query);
     for q in 0..queries {
-        let mut cost = r.next();
+        let mut cost = r.next_f64();
         for _ in 0..per_query {
-            let t = (q as f64 + 200.0 * (r.next() - 0.5)).clamp(0.0, queries as f64 - 1.0);
+            let t = (q as f64 + 200.0 * (r.next_f64() - 0.5)).clamp(0.0, queries as f64 - 1.0);
             targets.push(t as u32);
             costs.push(cost);
-            cost += r.next();
+            cost += r.next_f64();
         }
     }
     let lists = CandidateLists {
@@ -155,6 +221,6 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = affinity, algorithm_2, spectrum_and_map
+    targets = affinity, pair_algorithms, cosegmentation, spectrum_and_map, candidate_search
 }
 criterion_main!(benches);

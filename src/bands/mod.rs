@@ -7,9 +7,11 @@ use thiserror::Error;
 
 mod area_weighted_bands;
 mod band_table;
+mod synthetic_band_table;
 
 pub use area_weighted_bands::area_weighted_bands;
 pub use band_table::{BandOptions, BandWeighting, band_table};
+pub use synthetic_band_table::synthetic_band_table;
 
 /// Errors of the band stage.
 #[derive(Debug, Error)]

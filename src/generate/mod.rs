@@ -9,6 +9,11 @@
 //! the user seed and the shape index, with deterministic arithmetic only, so a seed gives the
 //! same bytes on every platform.
 //!
+//! Also seeded synthetic inputs for benchmarks and scaling studies, without any spectrum:
+//! smooth pseudo-features ([`smooth_features`], banded by
+//! [`crate::bands::synthetic_band_table`]), a bent grid ([`grid_mesh`]) and a finer copy of a
+//! mesh ([`refine_mesh`]).
+//!
 //! ```
 //! use coseg::generate::{generate_family, Family, GenerateOptions};
 //! let mut options = GenerateOptions::default();
@@ -24,10 +29,12 @@ mod generate_family;
 mod marching_tetrahedra;
 mod polygonise;
 mod sdf;
+mod synthetic;
 mod write_collection;
 
 pub use generate_family::{GenerateOptions, generate_family};
 pub use marching_tetrahedra::{ScalarGrid, marching_tetrahedra};
+pub use synthetic::{SmoothFeatures, SplitMix64, grid_mesh, refine_mesh, smooth_features};
 pub use write_collection::{MANIFEST_FORMAT, Manifest, ManifestShape, obj_text, write_collection};
 
 use crate::mesh::TriMesh;

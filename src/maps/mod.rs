@@ -19,6 +19,7 @@ pub use map_preset::{
     MapGuidedOptions, MapOverrides, MapPreset, MapStep, NEAR_ISOMETRIC_DISCREPANCY,
     PRESET_EIGENVALUES, PresetChoice, ResolvedMapStep, map_preset,
 };
+pub use nearest_rows::nearest_candidates;
 pub use region_point_map::{MapShape, PointMapOptions, region_point_map};
 pub use zoomout::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
 

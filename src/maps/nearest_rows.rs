@@ -39,7 +39,9 @@ const PROBES: usize = 10;
 /// at 0. With at least `PRUNE_FROM` base rows (and no NaN) only the members of each query's
 /// nearest clusters are compared (see the module notes): every returned candidate and cost
 /// is right, but a near row in an unprobed cluster can be missed.
-pub(crate) fn nearest_candidates(
+///
+/// This is ZoomOut's last-match search; it is public for benchmarks (`benches/core.rs`).
+pub fn nearest_candidates(
     base: MatRef<'_, f64>,
     query: MatRef<'_, f64>,
     count: usize,
