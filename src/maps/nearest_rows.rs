@@ -28,8 +28,9 @@ const CLUSTER_SIZE: usize = 64;
 /// Queries per group of the clustered search at most (a group shares its clusters).
 const GROUP_SIZE: usize = 128;
 
-/// Clusters probed per query by the clustered search, at least.
-const PROBES: usize = 10;
+/// Clusters probed per query by the clustered search, at least. 5 instead of 10 halved the
+/// search for the same TOSCA correspondence ratio (docs/PERFORMANCE.md, "Map step").
+const PROBES: usize = 5;
 
 /// For every row of `query`, the `count` nearest rows of `base` (capped by its rows) and
 /// their squared distances, nearest first; ties go to the lowest index. Both have the same
