@@ -169,19 +169,32 @@ fn region_options(args: &PairArgs) -> StableRegionsOptions {
     opts
 }
 
-/// Both shapes through the per-shape pipeline (and the cache), warnings printed.
+/// Both shapes through the per-shape pipeline (and the cache), side by side: warm, each
+/// shape's rebuild from its cache entry is mostly sequential work, so two at once use both
+/// cores. Warnings are printed in argument order, as if loaded one after the other.
 fn load_pair(
     args: &PairArgs,
     pipe: &ShapePipelineOptions,
     cache: Option<&Path>,
 ) -> Result<Vec<(TriMesh, ShapeData)>> {
-    let mut loaded = Vec::new();
     let bar = super::progress_bar(2);
-    for path in [&args.a, &args.b] {
+    if let Some(b) = &bar {
+        b.set_message("per-shape data");
+    }
+    let load = |path: &std::path::PathBuf| {
+        let shape = load_shape::<ShapeData>(path, pipe, cache);
         if let Some(b) = &bar {
-            b.set_message(format!("per-shape data: {}", path.display()));
+            b.inc(1);
         }
-        let shape = match load_shape::<ShapeData>(path, pipe, cache) {
+        shape
+    };
+    let (a, b) = rayon::join(|| load(&args.a), || load(&args.b));
+    if let Some(b) = bar {
+        b.finish_and_clear();
+    }
+    let mut loaded = Vec::new();
+    for (path, shape) in [(&args.a, a), (&args.b, b)] {
+        let shape = match shape {
             Ok(s) => s,
             Err(PipelineError::Mesh(e)) => return Err(e.into()),
             Err(e) => return Err(anyhow::Error::new(e).context(format!("{}", path.display()))),
@@ -190,12 +203,6 @@ fn load_pair(
             super::warn(w);
         }
         loaded.push((shape.mesh, shape.data));
-        if let Some(b) = &bar {
-            b.inc(1);
-        }
-    }
-    if let Some(b) = bar {
-        b.finish_and_clear();
     }
     Ok(loaded)
 }
