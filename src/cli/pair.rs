@@ -8,8 +8,9 @@ use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, writ
 use coseg::pipeline::{PipelineError, ShapeData, ShapePipelineOptions, load_shape};
 use coseg::render::{RenderOptions, RenderShape};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, PairShape, RefineOptions, SegmentPairOptions, SegmentedPair,
-    StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio, segment_pair,
+    Algorithm, AreaReference, Init, PairShape, PairTimes, RefineOptions, SegmentPairOptions,
+    SegmentedPair, StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio,
+    segment_pair,
 };
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -304,14 +305,7 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
         seconds,
         ratio,
         written.len(),
-    );
-    let t = &pair.times;
-    println!(
-        "stages: algorithm {:.2} s, smoothers {:.2} s, refinement {:.2} s, map step {:.2} s",
-        t.algorithm.as_secs_f64(),
-        t.smoothers.as_secs_f64(),
-        t.refine.as_secs_f64(),
-        t.map_guided.as_secs_f64()
+        &pair.times,
     );
     Ok(ExitCode::SUCCESS)
 }
@@ -396,6 +390,7 @@ fn report(
     seconds: f64,
     ratio: Option<f64>,
     files: usize,
+    times: &PairTimes,
 ) {
     if let Some(choice) = map_preset {
         println!(
@@ -420,6 +415,13 @@ fn report(
         )),
         files,
         args.output.display()
+    );
+    println!(
+        "stages: algorithm {:.2} s, smoothers {:.2} s, refinement {:.2} s, map step {:.2} s",
+        times.algorithm.as_secs_f64(),
+        times.smoothers.as_secs_f64(),
+        times.refine.as_secs_f64(),
+        times.map_guided.as_secs_f64()
     );
     if !args.no_pictures {
         let out = args.output.display();

@@ -159,11 +159,7 @@ impl ShapeBands {
         if self.key != *key {
             return Err("payload key does not match".into());
         }
-        let t = &self.bands;
-        let consistent = t.vertices == vertices
-            && t.labels.len() == t.features * vertices
-            && t.labels.iter().all(|&l| (l as usize) < t.bands)
-            && self.vertex_areas.len() == vertices;
+        let consistent = table_fits(&self.bands, vertices) && self.vertex_areas.len() == vertices;
         if !consistent {
             return Err("payload sizes do not match the mesh".into());
         }
@@ -172,6 +168,14 @@ impl ShapeBands {
         }
         Ok(())
     }
+}
+
+/// True when a band table read from a cache entry is sized for `vertices` vertices and every
+/// label is below its band count (the invariant the affinity kernel's unchecked reads rely on).
+fn table_fits(t: &BandTable, vertices: usize) -> bool {
+    t.vertices == vertices
+        && Some(t.labels.len()) == vertices.checked_mul(t.features)
+        && t.labels.iter().all(|&l| (l as usize) < t.bands)
 }
 
 /// What the full cache entry holds (format version 4): the spectrum with its eigenvectors
@@ -282,16 +286,13 @@ impl StoredShape {
         }
         let k = self.eigenvalues.len();
         let c = &self.kept_columns;
-        let t = &self.bands;
         let consistent = self.vertices == vertices
             && self.vertex_areas.len() == vertices
             && Some(self.eigenvectors.len()) == vertices.checked_mul(k)
             && c.vertices == vertices
             && Some(c.values.len()) == vertices.checked_mul(c.names.len())
             && self.kept_counts[0].checked_add(self.kept_counts[1]) == Some(c.names.len())
-            && t.vertices == vertices
-            && Some(t.labels.len()) == vertices.checked_mul(t.features)
-            && t.labels.iter().all(|&l| (l as usize) < t.bands);
+            && table_fits(&self.bands, vertices);
         if !consistent {
             return Err("payload sizes do not match the mesh".into());
         }

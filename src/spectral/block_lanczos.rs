@@ -13,6 +13,7 @@
 //! relation (their residuals all lie along `Q`).
 
 use super::SpectralError;
+use crate::generate::SplitMix64;
 use faer::linalg::matmul::matmul;
 use faer::reborrow::*;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
@@ -43,20 +44,15 @@ pub(crate) struct BlockLanczosResult {
     pub applications: usize,
 }
 
-/// SplitMix64: a tiny deterministic generator for start vectors (uniform in [-1, 1)).
-pub(crate) struct SplitMix(u64);
+/// Start vectors uniform in [-1, 1): [`SplitMix64`] from the seed mixed with a constant.
+pub(crate) struct SplitMix(SplitMix64);
 
 impl SplitMix {
     pub fn new(seed: u64) -> Self {
-        SplitMix(seed ^ 0x853c_49e6_748f_ea9b)
+        SplitMix(SplitMix64(seed ^ 0x853c_49e6_748f_ea9b))
     }
     pub fn next_f64(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^= z >> 31;
-        ((z >> 11) as f64) / ((1u64 << 53) as f64) * 2.0 - 1.0
+        self.0.next_f64() * 2.0 - 1.0
     }
 }
 

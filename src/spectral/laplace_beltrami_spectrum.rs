@@ -40,7 +40,7 @@ pub struct SpectrumOptions {
     /// left out of the serialised options and of cache keys. Inside a collection's parallel
     /// loop over shapes the nested work mostly runs on the thread that spawned it; for one
     /// shape (`coseg spectrum`, `coseg pair`) it uses every core: victoria0 (45,659 vertices,
-    /// k = 200) 5.3 s on 2 threads against 8.0 s sequential (docs/PERFORMANCE.md).
+    /// k = 200) 5.3 s on 2 threads against 8.0 s sequential (docs/RESULTS.md, "Spectrum").
     #[serde(skip)]
     pub threads: usize,
     /// Finish with one step of inverse iteration on the computed eigenvectors followed by a
