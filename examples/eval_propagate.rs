@@ -12,8 +12,10 @@
 //! # A shipped collection (per-vertex `<stem>.labels.txt` beside the meshes), as `chairs`.
 //! cargo run --release --example eval_propagate -- labelled collections/goblets
 //! ```
-//! Common options: `--sources A,B` (chairs: only these single sources), `--cache DIR` (default /tmp/coseg-eval-cache), `--size-prior A`,
-//! `--network-weight W`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
+//! Common options: `--sources A,B` (chairs: only these single sources), `--triple A,B,C` (only
+//! this set of sources), `--per-target` (accuracy, confusion and label counts of every target
+//! on stderr), `--cache DIR` (default /tmp/coseg-eval-cache), `--size-prior A`,
+//! `--network-weight W`, `--similarity-power P`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
 //! `--part-score affinity|geometric`, `--area-weighted true|false`, `--refit-rounds N`,
 //! `--refit-weight B`, `--update-relays true|false`;
 //! the per-shape pipeline as `coseg propagate` takes it: `--features spectral,extrinsic,sdf`,
@@ -214,7 +216,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut options = PropagateOptions::default();
     let mut graph = GraphOptions::default();
     let (mut triples, mut seed, mut parts) = (10usize, 0u64, 6usize);
+    let mut triple: Option<String> = None;
     let mut only: Option<Vec<String>> = None;
+    let mut per_target = false;
     let mut rest = Vec::new();
     let (mut features, mut up, mut weights) =
         ("spectral".to_string(), "y".to_string(), String::new());
@@ -230,6 +234,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--cache" => cache = PathBuf::from(val()?),
             "--size-prior" => options.size_prior = val()?.parse()?,
             "--network-weight" => options.network_weight = val()?.parse()?,
+            "--similarity-power" => options.similarity_power = val()?.parse()?,
             "--smoothing-time" => options.smoothing_time = val()?.parse()?,
             "--max-sweeps" => options.max_sweeps = val()?.parse()?,
             "--part-score" => {
@@ -251,6 +256,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--parts-from" => parts_from = val()?,
             "--seg" => seg = Some(PathBuf::from(val()?)),
             "--reps" => reps = val()?.parse()?,
+            "--per-target" => per_target = true,
+            "--triple" => triple = Some(val()?),
             "--sources" => only = Some(val()?.split(',').map(str::to_string).collect()),
             "--features" => features = val()?,
             "--up" => up = val()?,
@@ -326,11 +333,38 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             let ann = |i: usize| faces_to_vertices(&set.meshes[i], &gt[i]).unwrap();
             let score = |i: usize, l: &[i32]| {
-                face_label_agreement(&set.meshes[i], &gt[i], l)
-                    .unwrap()
-                    .accuracy
+                let a = face_label_agreement(&set.meshes[i], &gt[i], l).unwrap();
+                if per_target {
+                    let rows: Vec<String> = a
+                        .confusion
+                        .iter()
+                        .zip(&a.labels)
+                        .map(|(r, t)| {
+                            let c: Vec<String> = r.iter().map(|x| format!("{:.2}", x)).collect();
+                            format!("{t}: {}", c.join(" "))
+                        })
+                        .collect();
+                    let mut h = std::collections::BTreeMap::new();
+                    for &x in l {
+                        *h.entry(x).or_insert(0usize) += 1;
+                    }
+                    eprintln!(
+                        "  target {} {:.1} % [{}] {h:?}",
+                        set.names[i],
+                        100.0 * a.accuracy,
+                        rows.join(" | ")
+                    );
+                }
+                a.accuracy
             };
-            chairs(&set, &ann, &score, &options, triples, seed, only.as_deref())
+            chairs(
+                &set,
+                &ann,
+                &score,
+                &options,
+                (triples, seed, triple.as_deref()),
+                only.as_deref(),
+            )
         }
         "labelled" => {
             // A shipped collection: meshes and `<stem>.labels.txt` (per vertex) in one folder.
@@ -348,7 +382,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .unwrap()
                     .accuracy
             };
-            chairs(&set, &ann, &score, &options, triples, seed, only.as_deref())
+            chairs(
+                &set,
+                &ann,
+                &score,
+                &options,
+                (triples, seed, triple.as_deref()),
+                only.as_deref(),
+            )
         }
         "bench" => {
             // Timing, warm cache: MESH... (the first two are labelled), `--seg DIR` for face
@@ -407,11 +448,24 @@ fn chairs(
     ann: &dyn Fn(usize) -> Vec<i32>,
     score: &dyn Fn(usize, &[i32]) -> f64,
     options: &PropagateOptions,
-    triples: usize,
-    seed: u64,
+    (triples, seed, triple): (usize, u64, Option<&str>),
     only: Option<&[String]>,
 ) -> Result<(), Box<dyn std::error::Error>> {
     let n = set.names.len();
+    if let Some(t) = triple {
+        let src: Vec<usize> = t
+            .split(',')
+            .map(|s| {
+                set.names
+                    .iter()
+                    .position(|x| x == s)
+                    .ok_or(format!("--triple: no shape {s}"))
+            })
+            .collect::<Result<_, _>>()?;
+        let r = run(set, &src, ann, score, options)?;
+        println!("triple {t}: {:.2} %", 100.0 * mean(&r));
+        return Ok(());
+    }
     println!("| source | mean accuracy | worst target | seconds |\n|---|---|---|---|");
     let mut means = Vec::new();
     for s in 0..n {
@@ -438,7 +492,9 @@ fn chairs(
         set.names[ws],
         100.0 * wsv
     );
-    incremental(set, ann, score, options)?;
+    if let Err(e) = incremental(set, ann, score, options) {
+        println!("\nincremental: not run ({e})");
+    }
     if triples == 0 {
         return Ok(());
     }

@@ -385,3 +385,54 @@ fn area_weighted_votes_follow_the_parts_area_not_their_vertex_count() {
     let p = propagate_labels(&g, None, &ann, &o).unwrap();
     assert_eq!(p.labels[1], vec![0, 1]);
 }
+
+/// Two kinds of shape that share most features (so each source's transport reaches both
+/// kinds strongly) but label their parts in opposite conventions; the last two features tell
+/// the kinds apart (anti-correlated with the others on kind B), so their summaries differ.
+/// Shapes: A (source), B and B (sources), A (target).
+fn two_kinds(d: usize) -> (ShapeGraph, Vec<i32>, Vec<i32>) {
+    let features = 12;
+    let table = |kind_b: bool| {
+        let mut vals = vec![0.0; d * features];
+        for f in 0..features {
+            for v in 0..d {
+                let x = v as f64 / d as f64;
+                let y = (x + 0.05 * f as f64).powf(1.0 + f as f64 / 8.0);
+                vals[f * d + v] = if kind_b && f >= 10 { -y } else { y };
+            }
+        }
+        equal_count_bands(&vals, features, d, 8).unwrap()
+    };
+    let tables = vec![table(false), table(true), table(true), table(false)];
+    let a: Vec<i32> = (0..d).map(|v| if 2 * v < d { 10 } else { 11 }).collect();
+    let b: Vec<i32> = a.iter().map(|&l| 21 - l).collect();
+    (graph_of(tables), a, b)
+}
+
+/// Several sources vote on every shape; a source like the target (small summary distance)
+/// must outweigh unlike ones, even outnumbered: the kind-A target follows the one kind-A
+/// source's convention, not the two kind-B sources'. With every source counting alike (the
+/// default) the two B votes win.
+#[test]
+fn sources_like_the_target_outweigh_unlike_ones() {
+    let d = 80;
+    let (g, a, b) = two_kinds(d);
+    assert!(g.summary_distance(0, 3) < 1e-12 && g.summary_distance(1, 2) < 1e-12);
+    assert!(g.summary_distance(0, 1) > 0.1);
+    let ann = vec![Some(a.clone()), Some(b.clone()), Some(b), None];
+    let right =
+        |p: &coseg::propagate::Propagation| (0..d).filter(|&v| p.labels[3][v] == a[v]).count();
+    let flat = PropagateOptions::default();
+    assert_eq!(flat.similarity_power, 0.0);
+    let mut o = flat.clone();
+    o.similarity_power = 4.0;
+    let p = propagate_labels(&g, None, &ann, &o).unwrap();
+    let q = propagate_labels(&g, None, &ann, &flat).unwrap();
+    let (r, rq) = (right(&p), right(&q));
+    eprintln!(
+        "similarity power {}: {r}; 0: {rq} of {d}",
+        o.similarity_power
+    );
+    assert!(r >= d - 4, "{r} of {d}");
+    assert!(rq < d / 2, "without similarity weights: {rq} of {d}");
+}

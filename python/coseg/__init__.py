@@ -511,6 +511,7 @@ def propagate(
     smoothing_time: float = _D["propagate_smoothing_time"],
     max_sweeps: int = _D["max_sweeps"],
     network_weight: float = _D["network_weight"],
+    similarity_power: float = _D["similarity_power"],
     size_prior: float = _D["size_prior"],
     eigenpairs: int = _D["eigenpairs"],
     hks: int = _D["hks"],
@@ -550,6 +551,8 @@ def propagate(
     Options (defaults as ``coseg propagate``): ``smoothing_time`` (3e-3, unit-area surface; 0
     = none) of the part scores; ``max_sweeps`` (3) over the unlabelled shapes;
     ``network_weight`` (1; 0 = sources only) of labelled neighbours that are not sources;
+    ``similarity_power`` (0 = all sources alike; 4 helps on collections that mix kinds) how
+    much more a source like the target counts when several vote;
     ``size_prior`` (0.25, in [0, 1]) how strongly part sizes follow the sources' area
     shares; ``complete_limit`` (12) and ``neighbours`` (6) of the shape graph.
     ``part_names``: a JSON ``{label: name}`` file or a dict ``{label: name}`` (for a list of
@@ -570,6 +573,7 @@ def propagate(
         smoothing_time=smoothing_time,
         max_sweeps=max_sweeps,
         network_weight=network_weight,
+        similarity_power=similarity_power,
         size_prior=size_prior,
         cache_dir=_path(cache_dir),
         out=_path(out),

@@ -127,6 +127,9 @@ impl<'py> Opts<'py> {
         if let Some(v) = self.take("network_weight")? {
             p.network_weight = v;
         }
+        if let Some(v) = self.take("similarity_power")? {
+            p.similarity_power = v;
+        }
         if let Some(v) = self.take("size_prior")? {
             p.size_prior = v;
         }
@@ -339,6 +342,7 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("propagate_smoothing_time", po.smoothing_time)?;
     d.set_item("max_sweeps", po.max_sweeps)?;
     d.set_item("network_weight", po.network_weight)?;
+    d.set_item("similarity_power", po.similarity_power)?;
     d.set_item("size_prior", po.size_prior)?;
     d.set_item("map_preset", "auto")?;
     d.set_item("map_size", ZoomOutOptions::default().final_size)?;

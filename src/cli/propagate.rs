@@ -52,6 +52,10 @@ pub struct PropagateArgs {
     /// Vote weight of labelled neighbours that are not sources (0 = sources only).
     #[arg(long, default_value_t = PropagateOptions::default().network_weight)]
     network_weight: f64,
+    /// How much more a source like the target counts than an unlike one, when several vote
+    /// (weight `(d_min / d)^p` by summary distance; 0 = all alike).
+    #[arg(long, default_value_t = PropagateOptions::default().similarity_power)]
+    similarity_power: f64,
     /// How strongly part sizes follow the sources' area shares (0 … 1).
     #[arg(long, default_value_t = PropagateOptions::default().size_prior)]
     size_prior: f64,
@@ -81,6 +85,7 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
     options.propagate.smoothing_time = args.smoothing_time;
     options.propagate.max_sweeps = args.max_sweeps;
     options.propagate.network_weight = args.network_weight;
+    options.propagate.similarity_power = args.similarity_power;
     options.propagate.size_prior = args.size_prior;
     options.propagate.part_score = match args.part_score.as_str() {
         "affinity" => PartScore::Affinity,

@@ -115,6 +115,8 @@ impl Default for GraphOptions {
 pub struct ShapeGraph {
     graph: UnGraph<ShapeNode, ShapeEdge>,
     kind: GraphKind,
+    /// Per node, its [`shape_summary`] (kept for distances between shapes no edge joins).
+    summaries: Vec<Vec<f64>>,
 }
 
 /// A cheap affinity summary of a shape: the area-weighted correlations between the band labels
@@ -251,7 +253,28 @@ impl ShapeGraph {
                 },
             );
         }
-        Ok(Self { graph, kind })
+        Ok(Self {
+            graph,
+            kind,
+            summaries,
+        })
+    }
+
+    /// Summary distance between shapes `i` and `j` (RMS difference of their
+    /// [`shape_summary`]s, as the edges' [`ShapeEdge::distance`]), whether or not an edge joins
+    /// them.
+    ///
+    /// ```
+    /// use coseg::bands::equal_count_bands;
+    /// use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
+    /// let t = equal_count_bands(&[0.0, 1.0, 2.0, 3.0, 0.5, 2.5, 1.5, 3.5], 2, 4, 2).unwrap();
+    /// let nodes = (0..2).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 4]).unwrap()).collect();
+    /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
+    /// assert_eq!(g.summary_distance(0, 1), 0.0);
+    /// assert_eq!(g.summary_distance(0, 1), g.edge(0, 1).unwrap().distance);
+    /// ```
+    pub fn summary_distance(&self, i: usize, j: usize) -> f64 {
+        summary_distance(&self.summaries[i], &self.summaries[j])
     }
 
     /// Sets the weight of every feature pair on every edge (`None`: equal weights), e.g. a
