@@ -4,7 +4,7 @@
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    adaptive_cosegment, cosegment, refine_cosegmentation,
+    RefineSizes, adaptive_cosegment, cosegment, refine_cosegmentation_sized,
 };
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -42,6 +42,16 @@ pub struct SegmentCollectionOptions {
     /// smoothers are factored once). Not used with [`Self::parts`].
     #[serde(skip_serializing_if = "is_one")]
     pub starts: usize,
+    /// How the refinement treats region sizes (default [`RefineSizes::Free`], the classic
+    /// best response, which drifts towards equal areas). `coseg segment --parts` sets
+    /// [`RefineSizes::Keep`] with [`AdaptiveOptions::size_tolerance`], so the refinement moves
+    /// boundaries but keeps the sizes the adaptive stage read from the data (docs/PARTS.md).
+    #[serde(skip_serializing_if = "is_free")]
+    pub refine_sizes: RefineSizes,
+}
+
+fn is_free(r: &RefineSizes) -> bool {
+    *r == RefineSizes::Free
 }
 
 fn is_one(n: &usize) -> bool {
@@ -69,6 +79,7 @@ impl Default for SegmentCollectionOptions {
             feature_weights: None,
             parts: None,
             starts: 1,
+            refine_sizes: RefineSizes::Free,
         }
     }
 }
@@ -212,8 +223,13 @@ pub fn segment_collection(
         times.cosegment += t.elapsed();
         if let Some(refine) = refine {
             let t = Instant::now();
-            segmentation =
-                refine_cosegmentation(&graph, &segmentation, smoothers.as_deref(), refine)?;
+            segmentation = refine_cosegmentation_sized(
+                &graph,
+                &segmentation,
+                smoothers.as_deref(),
+                refine,
+                options.refine_sizes,
+            )?;
             times.refine += t.elapsed();
         }
         let score = start_score(&segmentation);
