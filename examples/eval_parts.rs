@@ -241,7 +241,8 @@ fn main() -> Res<()> {
             format!("purity {:.1} % coverage {:.1} %", 100.0 * p, 100.0 * c)
         };
         println!(
-            "{mode:>12}: {score}  parts {} (median sizes % {}){extra}  {secs:.2} s",
+            "{mode:>12}: {score}  confidence {:.3}  parts {} (median sizes % {}){extra}  {secs:.2} s",
+            coseg::graph::start_score(seg),
             seg.tuples.len(),
             sizes.join("/")
         );

@@ -60,10 +60,11 @@ pub struct SegmentArgs {
     /// every graph edge, see `coseg::graph::refine_cosegmentation`); 0 keeps the raw regions.
     #[arg(long, default_value_t = SegmentCollectionOptions::DEFAULT_REFINE.max_rounds)]
     refine_rounds: usize,
-    /// How the refinement treats part sizes: `keep` (each part's area on each shape stays
-    /// within the size tolerance, a factor 1.5, of its area before refinement), `keep:TOL`
-    /// (within a factor 1 + TOL) or `free` (the classic best response, which drifts towards
-    /// equal areas). Default: `keep` with `--parts`, `free` without. See docs/PARTS.md.
+    /// How the refinement treats part sizes: `free` (default: the classic best response,
+    /// which drifts towards equal areas), `keep` (each part's area on each shape stays within
+    /// the adaptive size tolerance, a factor 1.5, of its area before refinement; meant for
+    /// `--parts`, whose sizes come from the data) or `keep:TOL` (within a factor 1 + TOL).
+    /// See docs/PARTS.md.
     #[arg(long, value_parser = parse_refine_sizes)]
     refine_sizes: Option<RefineSizesArg>,
     /// Heat-smoothing time of the refinement (unit-area surface; 0 = no smoothing).
@@ -237,10 +238,9 @@ fn collection_options(
     o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
     o2.starts = args.starts;
     let tolerance = AdaptiveOptions::default().size_tolerance;
-    o2.refine_sizes = match (args.refine_sizes, args.parts.is_some()) {
-        (None, false) | (Some(RefineSizesArg::Free), _) => RefineSizes::Free,
-        (None, true) => RefineSizes::Keep { tolerance },
-        (Some(RefineSizesArg::Keep(t)), _) => RefineSizes::Keep {
+    o2.refine_sizes = match args.refine_sizes {
+        None | Some(RefineSizesArg::Free) => RefineSizes::Free,
+        Some(RefineSizesArg::Keep(t)) => RefineSizes::Keep {
             tolerance: t.unwrap_or(tolerance),
         },
     };

@@ -43,9 +43,10 @@ pub struct SegmentCollectionOptions {
     #[serde(skip_serializing_if = "is_one")]
     pub starts: usize,
     /// How the refinement treats region sizes (default [`RefineSizes::Free`], the classic
-    /// best response, which drifts towards equal areas). `coseg segment --parts` sets
-    /// [`RefineSizes::Keep`] with [`AdaptiveOptions::size_tolerance`], so the refinement moves
-    /// boundaries but keeps the sizes the adaptive stage read from the data (docs/PARTS.md).
+    /// best response, which drifts towards equal areas). With [`Self::parts`],
+    /// [`RefineSizes::Keep`] (`coseg segment --parts … --refine-sizes keep`, tolerance
+    /// [`AdaptiveOptions::size_tolerance`]) moves boundaries but keeps the sizes the adaptive
+    /// stage read from the data (measured on both sides in docs/PARTS.md).
     #[serde(skip_serializing_if = "is_free")]
     pub refine_sizes: RefineSizes,
 }
