@@ -69,10 +69,11 @@ pub enum RefineSizes {
     /// `s_r(q) · exp(θ_ir)`, with one factor per shape and region chosen so that region `r`'s
     /// area on shape `i` stays within a factor `1 + tolerance` of its area before refinement
     /// (the sizes [`adaptive_cosegment`](super::adaptive_cosegment) read from the data).
-    /// The factors are found by a damped multiplicative search (each round moves `θ_ir` by
-    /// half the log-ratio of the violated bound to the area, at most 50 rounds per shape
-    /// update, kept between sweeps), so boundaries move to where the scores cross while the
-    /// sizes stay the data's. A region empty on a shape before refinement stays empty there.
+    /// The factors are the dual variables of that size-constrained assignment, found by exact
+    /// coordinate steps (a region outside its band gets the `θ_ir` that puts its area on the
+    /// nearest bound, the others held; at most 20 passes over the regions per shape update,
+    /// kept between sweeps), so boundaries move to where the scores cross while the sizes
+    /// stay the data's. A region empty on a shape before refinement stays empty there.
     Keep {
         /// Allowed relative change of each region's area (`0.25`: within a factor 1.25).
         tolerance: f64,
