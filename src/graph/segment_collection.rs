@@ -94,7 +94,7 @@ pub struct SegmentTimes {
     pub cosegment: Duration,
     /// Factorising the heat smoothers (one per shape, in parallel).
     pub smoothers: Duration,
-    /// [`refine_cosegmentation`].
+    /// [`refine_cosegmentation`](super::refine_cosegmentation).
     pub refine: Duration,
 }
 
@@ -127,7 +127,7 @@ pub fn start_score(segmentation: &Cosegmentation) -> f64 {
 
 /// Co-segments a collection: builds the shape graph over `nodes`, extracts consistent region
 /// tuples with [`cosegment`], and (by default) refines their boundaries with
-/// [`refine_cosegmentation`], heat-smoothing on each shape's `meshes[i]` (same order as
+/// [`refine_cosegmentation`](super::refine_cosegmentation), heat-smoothing on each shape's `meshes[i]` (same order as
 /// `nodes`; only needed when refining with a positive smoothing time).
 ///
 /// Deterministic: the same nodes and options give the same segmentation, bit for bit.
