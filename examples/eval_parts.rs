@@ -1,8 +1,14 @@
 //! Co-segmentation modes scored against human or generated part labels (docs/PARTS.md).
 //!
 //! ```text
-//! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N] MODE...
+//! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N]
+//!     [--features F --up AXIS] [--starts N] [--keep-sizes TOL] [--detail] MODE...
 //! ```
+//! `--features`/`--up` select the feature families as `coseg segment` does (e.g.
+//! `--features spectral,extrinsic --up y`), `--starts` its several starts, `--keep-sizes TOL`
+//! the size-aware refinement (`RefineSizes::Keep`, `coseg segment --refine-sizes keep:TOL`;
+//! without it the free best response). `--detail` prints, for families, each shape's own
+//! purity / coverage and the pooled area table (region × grouped part, % of a shape).
 //! `FOLDER` is either a COSEG-style set (`shapes/N.off` and `gt/N.seg`, one label per face) or a
 //! shipped family (`collections/<family>`, per-vertex labels and a manifest). Each `MODE` is
 //! `fixed:R` (`cosegment`, R equal-area regions, today's `coseg segment --regions R`), `auto`
@@ -88,6 +94,7 @@ fn family_scores(
     loaded: &LoadedCollection,
     seg: &Cosegmentation,
     folder: &Path,
+    detail: bool,
 ) -> Res<(f64, f64)> {
     let truth = GroundTruth::read(folder)?;
     let mut shapes = Vec::new();
@@ -95,11 +102,46 @@ fn family_scores(
         let parts = truth.grouped_labels(&seg.names[i])?;
         shapes.push(ShapeParts::of_mesh(mesh, parts, seg.labels(i))?);
     }
+    if detail {
+        let per: Vec<String> = shapes
+            .iter()
+            .map(|s| {
+                let one = std::slice::from_ref(s);
+                format!(
+                    "{:.0}/{:.0}",
+                    100.0 * part_purity(one).unwrap_or(0.0),
+                    100.0 * part_coverage(one).unwrap_or(0.0)
+                )
+            })
+            .collect();
+        eprintln!("  per shape: {}", per.join(" "));
+        let parts = shapes
+            .iter()
+            .flat_map(|s| s.truth.iter().copied())
+            .max()
+            .unwrap_or(0)
+            + 1;
+        let ids = seg.tuples.len();
+        let mut conf = vec![vec![0.0; parts]; ids];
+        for s in &shapes {
+            let total: f64 = s.areas.iter().sum();
+            for ((&a, &t), &f) in s.areas.iter().zip(&s.truth).zip(&s.found) {
+                if f >= 0 {
+                    conf[f as usize][t] += a / total / shapes.len() as f64;
+                }
+            }
+        }
+        for (r, row) in conf.iter().enumerate() {
+            let cells: Vec<String> = row.iter().map(|x| format!("{:5.1}", 100.0 * x)).collect();
+            eprintln!("  region {r}: {}", cells.join(" "));
+        }
+    }
     Ok((part_purity(&shapes)?, part_coverage(&shapes)?))
 }
 
-fn options(mode: &str, refine_rounds: usize) -> Res<SegmentCollectionOptions> {
+fn options(mode: &str, refine_rounds: usize, starts: usize) -> Res<SegmentCollectionOptions> {
     let mut o = SegmentCollectionOptions::default();
+    o.starts = starts;
     if let Some(r) = o.refine.as_mut() {
         r.max_rounds = refine_rounds;
     }
@@ -134,8 +176,16 @@ fn main() -> Res<()> {
     let mut cache = std::env::temp_dir().join("coseg-eval-cache");
     let mut refine_rounds = SegmentCollectionOptions::DEFAULT_REFINE.max_rounds;
     let mut modes = Vec::new();
+    let (mut features, mut up, mut starts) = ("spectral".to_string(), "y".to_string(), 1);
+    let mut keep: Option<f64> = None;
+    let mut detail = false;
     while let Some(a) = args.next() {
         match a.as_str() {
+            "--features" => features = args.next().ok_or("--features F")?,
+            "--up" => up = args.next().ok_or("--up AXIS")?,
+            "--starts" => starts = args.next().ok_or("--starts N")?.parse()?,
+            "--detail" => detail = true,
+            "--keep-sizes" => keep = Some(args.next().ok_or("--keep-sizes TOL")?.parse()?),
             "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),
             "--refine-rounds" => refine_rounds = args.next().ok_or("--refine-rounds N")?.parse()?,
             _ => modes.push(a),
@@ -147,17 +197,19 @@ fn main() -> Res<()> {
     } else {
         folder.clone()
     };
-    let loaded = load_collection(
-        &shapes,
-        &ShapePipelineOptions::default(),
-        &cache,
-        |_, _, _| {},
-    )?;
+    let mut pipeline = ShapePipelineOptions::default();
+    let directions = coseg::features::ExtrinsicOptions::default().directions;
+    pipeline.set_families(&features, &up, directions, 0, "")?;
+    let loaded = load_collection(&shapes, &pipeline, &cache, |_, _, _| {})?;
     for s in &loaded.skipped {
         eprintln!("skipped: {}", s.error);
     }
     for mode in &modes {
-        let o = options(mode, refine_rounds)?;
+        let mut o = options(mode, refine_rounds, starts)?;
+        o.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
+        if let Some(tolerance) = keep {
+            o.refine_sizes = coseg::graph::RefineSizes::Keep { tolerance };
+        }
         let t = Instant::now();
         let out = segment_collection(loaded.nodes.clone(), &loaded.meshes, &o)?;
         let secs = t.elapsed().as_secs_f64();
@@ -185,11 +237,12 @@ fn main() -> Res<()> {
                 100.0 * coseg_accuracy(&loaded, seg, &folder.join("gt"))?
             )
         } else {
-            let (p, c) = family_scores(&loaded, seg, &folder)?;
+            let (p, c) = family_scores(&loaded, seg, &folder, detail)?;
             format!("purity {:.1} % coverage {:.1} %", 100.0 * p, 100.0 * c)
         };
         println!(
-            "{mode:>12}: {score}  parts {} (median sizes % {}){extra}  {secs:.2} s",
+            "{mode:>12}: {score}  confidence {:.3}  parts {} (median sizes % {}){extra}  {secs:.2} s",
+            coseg::graph::start_score(seg),
             seg.tuples.len(),
             sizes.join("/")
         );

@@ -133,6 +133,47 @@ fn regression_quiet_parts_auto_prints_nothing() {
     );
 }
 
+/// `--refine-sizes`: `keep` and `keep:TOL` are recorded in summary.json (the adaptive size
+/// tolerance by default), `free` and no flag record nothing (the default mode's summary is
+/// unchanged), anything else is refused.
+#[test]
+fn refine_sizes_is_recorded_and_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 2, 2);
+    let run_with = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
+        args.extend(FAST);
+        args.extend(["--parts", "auto"]);
+        args.extend(extra);
+        let run = coseg(&args);
+        (run, out)
+    };
+    let summary = |out: &Path| std::fs::read_to_string(out.join("summary.json")).unwrap();
+    let (run, out) = run_with("keep", &["--refine-sizes", "keep"]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    let s_keep = summary(&out);
+    assert!(
+        s_keep.contains("\"refine_sizes\"") && s_keep.contains("\"tolerance\": 0.5"),
+        "{s_keep}"
+    );
+    let (run, out) = run_with("keep25", &["--refine-sizes", "keep:0.25"]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    assert!(summary(&out).contains("\"tolerance\": 0.25"));
+    let (run, free) = run_with("free", &["--refine-sizes", "free"]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    let (run, none) = run_with("none", &[]);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    assert!(!summary(&free).contains("refine_sizes"));
+    assert_eq!(files(&free), files(&none));
+    for bad in ["keep:-1", "keep:x", "fixed"] {
+        let (run, _) = run_with(&format!("bad{bad}"), &["--refine-sizes", bad]);
+        assert_eq!(run.status.code(), Some(2), "{bad}: {}", text(&run.stderr));
+    }
+}
+
 #[test]
 fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
     let dir = tempfile::tempdir().unwrap();

@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{
-    AdaptiveOptions, CosegmentOptions, GraphOptions, LoadedCollection, PartsReport,
+    AdaptiveOptions, CosegmentOptions, GraphOptions, LoadedCollection, PartsReport, RefineSizes,
     SegmentCollectionOptions, SegmentedCollection, load_collection, segment_collection,
 };
 use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
@@ -60,11 +60,37 @@ pub struct SegmentArgs {
     /// every graph edge, see `coseg::graph::refine_cosegmentation`); 0 keeps the raw regions.
     #[arg(long, default_value_t = SegmentCollectionOptions::DEFAULT_REFINE.max_rounds)]
     refine_rounds: usize,
+    /// How the refinement treats part sizes: `free` (default: the classic best response,
+    /// which drifts towards equal areas), `keep` (each part's area on each shape stays within
+    /// the adaptive size tolerance, a factor 1.5, of its area before refinement; meant for
+    /// `--parts`, whose sizes come from the data) or `keep:TOL` (within a factor 1 + TOL).
+    /// See docs/PARTS.md.
+    #[arg(long, value_parser = parse_refine_sizes)]
+    refine_sizes: Option<RefineSizesArg>,
     /// Heat-smoothing time of the refinement (unit-area surface; 0 = no smoothing).
     #[arg(long, default_value_t = SegmentCollectionOptions::DEFAULT_REFINE.smoothing_time)]
     smoothing_time: f64,
     #[command(flatten)]
     pipeline: super::pipeline_args::PipelineArgs,
+}
+
+/// `--refine-sizes free|keep[:TOL]`.
+#[derive(Debug, Clone, Copy)]
+enum RefineSizesArg {
+    Free,
+    Keep(Option<f64>),
+}
+
+fn parse_refine_sizes(s: &str) -> Result<RefineSizesArg, String> {
+    let bad = || format!("{s:?}: expected `free`, `keep` or `keep:TOL` (TOL ≥ 0)");
+    match s {
+        "free" => Ok(RefineSizesArg::Free),
+        "keep" => Ok(RefineSizesArg::Keep(None)),
+        _ => match s.strip_prefix("keep:").map(str::parse::<f64>) {
+            Some(Ok(t)) if t.is_finite() && t >= 0.0 => Ok(RefineSizesArg::Keep(Some(t))),
+            _ => Err(bad()),
+        },
+    }
 }
 
 /// `--parts auto|N`.
@@ -211,6 +237,13 @@ fn collection_options(
     });
     o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
     o2.starts = args.starts;
+    let tolerance = AdaptiveOptions::default().size_tolerance;
+    o2.refine_sizes = match args.refine_sizes {
+        None | Some(RefineSizesArg::Free) => RefineSizes::Free,
+        Some(RefineSizesArg::Keep(t)) => RefineSizes::Keep {
+            tolerance: t.unwrap_or(tolerance),
+        },
+    };
     o2.parts = args.parts.map(|p| {
         let mut o = AdaptiveOptions::default();
         if let PartsArg::Count(k) = p {

@@ -7,6 +7,7 @@ use crate::affinity::kernel::{Block, LANES, row_sum};
 use crate::spectral::HeatSmoother;
 use crate::stable::{RefineOptions, StableError, assign_regions};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 /// Refines a co-segmentation's region ids on every shape, as
 /// [`refine_partition`](crate::stable::refine_partition) does for two shapes: in
@@ -50,7 +51,52 @@ pub fn refine_cosegmentation(
     smoothers: Option<&[HeatSmoother]>,
     options: &RefineOptions,
 ) -> Result<Cosegmentation, GraphError> {
+    refine_cosegmentation_sized(graph, coseg, smoothers, options, RefineSizes::Free)
+}
+
+/// How [`refine_cosegmentation_sized`] treats the regions' sizes.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "rule")]
+pub enum RefineSizes {
+    /// The free best response of [`refine_cosegmentation`] (default). Its scores are mean
+    /// affinities (normalised by the region's size), so inside a region a vertex's score is
+    /// about inversely proportional to the region's spread in band space: a small region's
+    /// score peaks higher, wins the vertices on a shared boundary, and the regions drift
+    /// towards equal areas (measured on the shipped families, docs/PARTS.md).
+    #[default]
+    Free,
+    /// Size-aware best response: each vertex of shape `i` takes the region maximising
+    /// `s_r(q) · exp(θ_ir)`, with one factor per shape and region chosen so that region `r`'s
+    /// area on shape `i` stays within a factor `1 + tolerance` of its area before refinement
+    /// (the sizes [`adaptive_cosegment`](super::adaptive_cosegment) read from the data).
+    /// The factors are the dual variables of that size-constrained assignment, found by exact
+    /// coordinate steps (a region outside its band gets the `θ_ir` that puts its area on the
+    /// nearest bound, the others held; at most 20 passes over the regions per shape update,
+    /// kept between sweeps), so boundaries move to where the scores cross while the sizes
+    /// stay the data's. A region empty on a shape before refinement stays empty there.
+    Keep {
+        /// Allowed relative change of each region's area (`0.25`: within a factor 1.25).
+        tolerance: f64,
+    },
+}
+
+/// [`refine_cosegmentation`] with a size rule ([`RefineSizes`]); `RefineSizes::Free` is
+/// [`refine_cosegmentation`] bit for bit.
+pub fn refine_cosegmentation_sized(
+    graph: &ShapeGraph,
+    coseg: &Cosegmentation,
+    smoothers: Option<&[HeatSmoother]>,
+    options: &RefineOptions,
+    sizes: RefineSizes,
+) -> Result<Cosegmentation, GraphError> {
     check_inputs(graph, coseg, smoothers, options)?;
+    if let RefineSizes::Keep { tolerance } = sizes
+        && !(tolerance.is_finite() && tolerance >= 0.0)
+    {
+        return Err(GraphError::BadOption(format!(
+            "size tolerance = {tolerance} must be finite and non-negative"
+        )));
+    }
     let n = graph.node_count();
     let regions = coseg.tuples.len();
     let mut labels: Vec<Vec<i32>> = (0..n).map(|i| coseg.labels(i)).collect();
@@ -68,6 +114,17 @@ pub fn refine_cosegmentation(
     let neighbours: Vec<Vec<usize>> = (0..n)
         .map(|i| graph.neighbours(i).into_iter().map(|(j, _)| j).collect())
         .collect();
+    // Size-aware rule: per-shape area fractions before refinement, and the log factors.
+    let targets: Option<(f64, Vec<Vec<f64>>)> = match sizes {
+        RefineSizes::Free => None,
+        RefineSizes::Keep { tolerance } => Some((
+            tolerance,
+            (0..n)
+                .map(|i| coseg.tuples.iter().map(|t| t.area_fractions[i]).collect())
+                .collect(),
+        )),
+    };
+    let mut theta: Vec<Vec<f64>> = vec![vec![0.0; regions]; n];
     let mut clock = 1usize;
     let mut changed_at = vec![clock; n];
     let mut updated_at = vec![0usize; n];
@@ -84,7 +141,22 @@ pub fn refine_cosegmentation(
             let smoother = smoothers
                 .filter(|_| options.smoothing_time > 0.0)
                 .map(|s| &s[i]);
-            let (new, margin) = assign_regions(&mut total, regions, smoother).map_err(stable)?;
+            let (new, margin) = match &targets {
+                None => assign_regions(&mut total, regions, smoother).map_err(stable)?,
+                Some((tolerance, t)) => {
+                    if let Some(s) = smoother {
+                        s.smooth(&mut total, regions)
+                            .map_err(|e| GraphError::BadOption(e.to_string()))?;
+                    }
+                    assign_sized(
+                        &total,
+                        &graph.node(i).areas,
+                        &t[i],
+                        *tolerance,
+                        &mut theta[i],
+                    )
+                }
+            };
             if new != labels[i] {
                 changed = true;
                 changed_at[i] = clock;
@@ -100,6 +172,134 @@ pub fn refine_cosegmentation(
     }
     Ok(refined(graph, coseg, &labels, &margins, rounds, converged))
 }
+
+/// The size-aware assignment of one shape ([`RefineSizes::Keep`]): `scores` column-major
+/// `d × R` (already smoothed), `areas` per vertex, `target[r]` = region `r`'s area fraction
+/// before refinement, `theta[r]` the log factors (updated in place, warm start). Each vertex
+/// takes `argmax_r ln s_r(q) + θ_r`; passes over the regions set, for each region whose area
+/// is outside its band `[target / (1 + τ), target (1 + τ)]`, its `θ_r` exactly to the value
+/// that puts the area on the nearest bound with the others held (a coordinate step of the
+/// dual of the size-constrained assignment), until every area is inside or after
+/// [`SIZE_PASSES`] passes. Returns the labels and the margins `(best − second) / best` of the
+/// scaled scores.
+fn assign_sized(
+    scores: &[f64],
+    areas: &[f64],
+    target: &[f64],
+    tolerance: f64,
+    theta: &mut [f64],
+) -> (Vec<i32>, Vec<f64>) {
+    let regions = target.len();
+    let d = areas.len();
+    let total: f64 = areas.iter().sum();
+    let log = |r: usize, q: usize| -> f64 {
+        let s = scores[r * d + q];
+        if target[r] > 0.0 && s > 0.0 {
+            s.ln()
+        } else {
+            f64::NEG_INFINITY
+        }
+    };
+    let mut t: Vec<(f64, usize)> = Vec::with_capacity(d);
+    for _ in 0..SIZE_PASSES {
+        let mut moved = false;
+        for r in 0..regions {
+            if target[r] <= 0.0 || total <= 0.0 {
+                continue;
+            }
+            // t_q: the factor above which region r wins vertex q, the others held.
+            t.clear();
+            let mut got = 0.0;
+            for (q, &area) in areas.iter().enumerate() {
+                let lr = log(r, q);
+                let other = (0..regions)
+                    .filter(|&x| x != r)
+                    .map(|x| log(x, q) + theta[x])
+                    .fold(f64::NEG_INFINITY, f64::max);
+                let tq = other - lr;
+                if !tq.is_nan() {
+                    if theta[r] > tq {
+                        got += area;
+                    }
+                    t.push((tq, q));
+                }
+            }
+            let a = got / total;
+            let bound = if a > target[r] * (1.0 + tolerance) {
+                target[r] * (1.0 + tolerance)
+            } else if a < target[r] / (1.0 + tolerance) {
+                target[r] / (1.0 + tolerance)
+            } else {
+                continue;
+            };
+            t.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            // The shortest prefix of the sorted t whose area reaches the bound.
+            let mut acc = 0.0;
+            let mut k = t.len();
+            for (idx, &(_, q)) in t.iter().enumerate() {
+                acc += areas[q] / total;
+                if acc >= bound {
+                    k = idx;
+                    break;
+                }
+            }
+            let next = |k: usize| t.get(k + 1).map_or(f64::INFINITY, |x| x.0);
+            let value = if k >= t.len() {
+                t.last().map_or(0.0, |x| x.0) + 1.0
+            } else {
+                let (lo, hi) = (t[k].0, next(k));
+                if hi.is_finite() && lo.is_finite() {
+                    0.5 * (lo + hi)
+                } else if lo.is_finite() {
+                    lo + 1.0
+                } else {
+                    continue;
+                }
+            };
+            if value.is_finite() && value != theta[r] {
+                theta[r] = value;
+                moved = true;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    // Only differences of the factors matter: centre them (they stay bounded across sweeps).
+    let live: Vec<usize> = (0..regions).filter(|&r| target[r] > 0.0).collect();
+    if !live.is_empty() {
+        let mean = live.iter().map(|&r| theta[r]).sum::<f64>() / live.len() as f64;
+        for &r in &live {
+            theta[r] -= mean;
+        }
+    }
+    let mut labels = vec![0i32; d];
+    let mut margins = vec![0.0; d];
+    for q in 0..d {
+        let (mut best, mut second, mut arg) = (f64::NEG_INFINITY, f64::NEG_INFINITY, 0usize);
+        for (r, &th) in theta.iter().enumerate() {
+            let s = log(r, q) + th;
+            if s > best {
+                second = best;
+                best = s;
+                arg = r;
+            } else if s > second {
+                second = s;
+            }
+        }
+        labels[q] = arg as i32;
+        // (best − second) / best of the scaled scores exp(s): 1 − exp(second − best).
+        margins[q] = if best.is_finite() {
+            (1.0 - (second - best).exp()).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+    }
+    (labels, margins)
+}
+
+/// Passes over the regions of the factor search of [`assign_sized`] per shape update.
+const SIZE_PASSES: usize = 20;
 
 /// The inputs must belong together and the smoothing time be usable; checked before any work so
 /// that a mismatch is the caller's error.

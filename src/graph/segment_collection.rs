@@ -4,7 +4,7 @@
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    adaptive_cosegment, cosegment, refine_cosegmentation,
+    RefineSizes, adaptive_cosegment, cosegment, refine_cosegmentation_sized,
 };
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -42,6 +42,17 @@ pub struct SegmentCollectionOptions {
     /// smoothers are factored once). Not used with [`Self::parts`].
     #[serde(skip_serializing_if = "is_one")]
     pub starts: usize,
+    /// How the refinement treats region sizes (default [`RefineSizes::Free`], the classic
+    /// best response, which drifts towards equal areas). With [`Self::parts`],
+    /// [`RefineSizes::Keep`] (`coseg segment --parts … --refine-sizes keep`, tolerance
+    /// [`AdaptiveOptions::size_tolerance`]) moves boundaries but keeps the sizes the adaptive
+    /// stage read from the data (measured on both sides in docs/PARTS.md).
+    #[serde(skip_serializing_if = "is_free")]
+    pub refine_sizes: RefineSizes,
+}
+
+fn is_free(r: &RefineSizes) -> bool {
+    *r == RefineSizes::Free
 }
 
 fn is_one(n: &usize) -> bool {
@@ -69,6 +80,7 @@ impl Default for SegmentCollectionOptions {
             feature_weights: None,
             parts: None,
             starts: 1,
+            refine_sizes: RefineSizes::Free,
         }
     }
 }
@@ -82,7 +94,7 @@ pub struct SegmentTimes {
     pub cosegment: Duration,
     /// Factorising the heat smoothers (one per shape, in parallel).
     pub smoothers: Duration,
-    /// [`refine_cosegmentation`].
+    /// [`refine_cosegmentation`](super::refine_cosegmentation).
     pub refine: Duration,
 }
 
@@ -115,7 +127,7 @@ pub fn start_score(segmentation: &Cosegmentation) -> f64 {
 
 /// Co-segments a collection: builds the shape graph over `nodes`, extracts consistent region
 /// tuples with [`cosegment`], and (by default) refines their boundaries with
-/// [`refine_cosegmentation`], heat-smoothing on each shape's `meshes[i]` (same order as
+/// [`refine_cosegmentation`](super::refine_cosegmentation), heat-smoothing on each shape's `meshes[i]` (same order as
 /// `nodes`; only needed when refining with a positive smoothing time).
 ///
 /// Deterministic: the same nodes and options give the same segmentation, bit for bit.
@@ -212,8 +224,13 @@ pub fn segment_collection(
         times.cosegment += t.elapsed();
         if let Some(refine) = refine {
             let t = Instant::now();
-            segmentation =
-                refine_cosegmentation(&graph, &segmentation, smoothers.as_deref(), refine)?;
+            segmentation = refine_cosegmentation_sized(
+                &graph,
+                &segmentation,
+                smoothers.as_deref(),
+                refine,
+                options.refine_sizes,
+            )?;
             times.refine += t.elapsed();
         }
         let score = start_score(&segmentation);
