@@ -715,3 +715,26 @@ fn segment_collection_keeps_the_start_of_highest_confidence() {
         .is_err()
     );
 }
+
+/// Regression: a segmentation into one part splits nothing and has confidence 1, so with
+/// `--parts auto --starts N` a start whose extraction found no tuple won over every real
+/// segmentation (shipped goblets 89.0/81.6 → 72.2/100, one part). It must score 0.
+#[test]
+fn start_score_of_a_single_part_is_zero() {
+    use coseg::graph::{SegmentCollectionOptions, segment_collection, start_score};
+    let mesh = common::shapes::icosphere(2, 1.0);
+    let d = mesh.vertex_count();
+    let (tables, areas) = noisy_collection(4, d, 5);
+    let meshes = vec![mesh; 4];
+    let mut opts = SegmentCollectionOptions::default();
+    opts.refine = None;
+    opts.cosegment.regions = 1;
+    let one = segment_collection(nodes_from(&tables, &areas), &meshes, &opts).unwrap();
+    assert_eq!(one.segmentation.tuples.len(), 1);
+    assert!(one.segmentation.tuples[0].confidence > 0.99);
+    assert_eq!(start_score(&one.segmentation), 0.0);
+    opts.cosegment.regions = 3;
+    let three = segment_collection(nodes_from(&tables, &areas), &meshes, &opts).unwrap();
+    assert!(three.segmentation.tuples.len() >= 2);
+    assert!(start_score(&three.segmentation) > 0.0);
+}
