@@ -119,6 +119,13 @@ pub fn auction_assignment(
     let mut cheapest_price = vec![0.0f64; target_count];
     let mut queue: VecDeque<usize> = (0..queries).collect();
     while let Some(q) = queue.pop_front() {
+        // The queue is long and a requeued query's lists were last read long ago: fetching
+        // the lists of a query a few bids ahead hides part of the memory latency (1.65 →
+        // 1.45 s for the 3.6 M bids of victoria0 × david0; same bids, same result).
+        if let Some(&next) = queue.get(PREFETCH_AHEAD) {
+            prefetch(&candidates.targets[next * k]);
+            prefetch(&candidates.costs[next * k]);
+        }
         bids += 1;
         let targets = &candidates.targets[q * k..(q + 1) * k];
         let costs = &candidates.costs[q * k..(q + 1) * k];
@@ -163,6 +170,23 @@ pub fn auction_assignment(
         exclusive,
         bids,
     })
+}
+
+/// How many bids ahead [`auction_assignment`] fetches a query's candidate lists.
+const PREFETCH_AHEAD: usize = 4;
+
+/// Asks the processor to bring the cache line holding `x` closer; no effect on results.
+#[inline(always)]
+fn prefetch<T>(x: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch is a hint that never faults and reads nothing the program sees; the
+    // address comes from a live reference.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>((x as *const T).cast::<i8>());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = x;
 }
 
 /// The median nearest cost, or (when it is 0: exact matches) the mean candidate cost, or 1.

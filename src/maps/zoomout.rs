@@ -5,7 +5,7 @@ use super::nearest_rows::gather_rows;
 use super::{AuctionOptions, CandidateLists, auction_assignment};
 use crate::spectral::{SpectralError, Spectrum};
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef, Par};
+use faer::{Accum, Mat, MatMut, MatRef, Par};
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
 
@@ -251,8 +251,10 @@ pub(crate) fn zoomout_from(
     let phi_a = eigenvectors(a.spectrum, final_size);
     let phi_b = eigenvectors(b.spectrum, final_size);
     let samples = options.samples.max(2 * final_size);
-    let samples_a = sample_rows(phi_a, a.positions, samples);
-    let samples_b = sample_rows(phi_b, b.positions, samples);
+    let (samples_a, samples_b) = rayon::join(
+        || sample_rows(phi_a, a.positions, samples),
+        || sample_rows(phi_b, b.positions, samples),
+    );
     let mut c = c0;
     let mut k = c.ncols();
     while k < final_size {
@@ -264,19 +266,21 @@ pub(crate) fn zoomout_from(
         c = spectral_fit(samples_b.subcols(0, next), samples_a.subcols(0, next), &t)?;
         k = next;
     }
-    let base = pulled_back(phi_a, &c);
     let lambda = options.descriptor_weight;
     match (a.descriptors, b.descriptors) {
         (Some(da), Some(db)) if lambda > 0.0 => {
-            let plain = base;
             let w = options.descriptor_weights.as_deref();
-            let base = with_descriptors(plain.as_ref(), da, lambda, w);
-            // The plain embedding is not needed any more: free it before the search.
-            drop(plain);
-            let query = with_descriptors(phi_b.subcols(0, k), db, lambda, w);
+            let (base, query) = rayon::join(
+                || with_descriptors(Embedding::PulledBack(phi_a, &c), da, lambda, w),
+                || with_descriptors(Embedding::Plain(phi_b.subcols(0, k)), db, lambda, w),
+            );
             final_point_map(&base, query.as_ref(), &options.final_match)
         }
-        _ => final_point_map(&base, phi_b.subcols(0, k), &options.final_match),
+        _ => final_point_map(
+            &pulled_back(phi_a, &c),
+            phi_b.subcols(0, k),
+            &options.final_match,
+        ),
     }
 }
 
@@ -298,15 +302,27 @@ fn final_point_map(
     }
 }
 
-/// `[x | λ D̂]`: `x` (`d × k`) with the descriptors appended as columns, each scaled to unit
-/// Euclidean norm and then by `λ` (and by `√(w_j / mean w)` with per-column weights).
+/// The spectral part of a last-match embedding.
+enum Embedding<'a> {
+    /// These coordinates as they are (B's `Φ_B`).
+    Plain(MatRef<'a, f64>),
+    /// `Φ Cᵀ` ([`pulled_back`]; A's).
+    PulledBack(MatRef<'a, f64>, &'a DMatrix<f64>),
+}
+
+/// `[x | λ D̂]`: the spectral coordinates `x` (`d × k`) with the descriptors appended as
+/// columns, each scaled to unit Euclidean norm and then by `λ` (and by `√(w_j / mean w)` with
+/// per-column weights). Written in place: one `d × (k + n)` matrix, no intermediate.
 fn with_descriptors(
-    x: MatRef<'_, f64>,
+    x: Embedding<'_>,
     descriptors: &[f64],
     lambda: f64,
     weights: Option<&[f64]>,
 ) -> Mat<f64> {
-    let (d, k) = (x.nrows(), x.ncols());
+    let (d, k) = match x {
+        Embedding::Plain(x) => (x.nrows(), x.ncols()),
+        Embedding::PulledBack(phi, c) => (phi.nrows(), c.nrows()),
+    };
     let n = descriptors.len() / d;
     // Checked by `validate`: one finite, non-negative weight per column, not all zero.
     let relative: Option<Vec<f64>> = weights.map(|w| {
@@ -323,8 +339,13 @@ fn with_descriptors(
         })
         .collect();
     let mut out = Mat::<f64>::zeros(d, k + n);
-    for j in 0..k {
-        out.col_mut(j).copy_from(x.col(j));
+    match x {
+        Embedding::Plain(x) => {
+            for j in 0..k {
+                out.col_mut(j).copy_from(x.col(j));
+            }
+        }
+        Embedding::PulledBack(phi, c) => pull_back_into(out.subcols_mut(0, k), phi, c),
     }
     for (j, col) in descriptors.chunks_exact(d).enumerate() {
         let dst = out
@@ -348,18 +369,24 @@ pub(crate) fn eigenvectors(s: &Spectrum, k: usize) -> MatRef<'_, f64> {
 /// `Φ Cᵀ` over the first `C.ncols()` columns of `Φ`: A's spectral embedding expressed in B's
 /// basis, whose rows are compared with B's rows `Φ_B(q)`.
 fn pulled_back(phi: MatRef<'_, f64>, c: &DMatrix<f64>) -> Mat<f64> {
+    let mut out = Mat::zeros(phi.nrows(), c.nrows());
+    pull_back_into(out.as_mut(), phi, c);
+    out
+}
+
+/// Rows per task of [`pull_back_into`]: fixed, so every row is computed by the same
+/// sequential product whatever the thread count.
+const PULL_BACK_ROWS: usize = 4096;
+
+/// `out = Φ Cᵀ` (`out` is `Φ.nrows() × C.nrows()`), in parallel over fixed blocks of rows.
+fn pull_back_into(out: MatMut<'_, f64>, phi: MatRef<'_, f64>, c: &DMatrix<f64>) {
+    use rayon::prelude::*;
     let k = c.ncols();
     let ct = Mat::from_fn(k, c.nrows(), |i, j| c[(j, i)]);
-    let mut out = Mat::zeros(phi.nrows(), c.nrows());
-    matmul(
-        out.as_mut(),
-        Accum::Replace,
-        phi.subcols(0, k),
-        ct.as_ref(),
-        1.0,
-        Par::Seq,
-    );
-    out
+    let phi = phi.subcols(0, k);
+    out.par_row_chunks_mut(PULL_BACK_ROWS)
+        .zip(phi.par_row_chunks(PULL_BACK_ROWS))
+        .for_each(|(out, phi)| matmul(out, Accum::Replace, phi, ct.as_ref(), 1.0, Par::Seq));
 }
 
 /// Least-squares functional map of a point map: `C = argmin ‖Φ_B C − Φ_A[T]‖` (rows of `phi_b`
@@ -487,4 +514,47 @@ fn nearest_rows(base: &Mat<f64>, query: MatRef<'_, f64>) -> Vec<u32> {
 /// their squared distances, nearest first (ties to the lowest index).
 fn nearest_candidates(base: &Mat<f64>, query: MatRef<'_, f64>, count: usize) -> CandidateLists {
     super::nearest_rows::nearest_candidates(base.as_ref(), query, count)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The blocked parallel `Φ Cᵀ` gives every row the bits of one sequential product of the
+    /// whole matrix, whatever the thread count (the last match's embedding, and so the map,
+    /// must not depend on it).
+    #[test]
+    fn pull_back_is_the_sequential_product_bit_for_bit() {
+        let (d, k) = (2 * PULL_BACK_ROWS + 517, 23);
+        let phi = Mat::from_fn(d, k + 4, |i, j| {
+            ((i * 7 + j * 13) % 101) as f64 / 37.0 - 1.3
+        });
+        let c = DMatrix::from_fn(k, k, |i, j| ((i * 5 + j * 3) % 17) as f64 / 9.0 - 0.8);
+        let ct = Mat::from_fn(k, k, |i, j| c[(j, i)]);
+        let mut sequential = Mat::<f64>::zeros(d, k);
+        matmul(
+            sequential.as_mut(),
+            Accum::Replace,
+            phi.subcols(0, k),
+            ct.as_ref(),
+            1.0,
+            Par::Seq,
+        );
+        for threads in [1, 2, 3] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let out = pool.install(|| pulled_back(phi.as_ref(), &c));
+            for j in 0..k {
+                for i in 0..d {
+                    assert_eq!(
+                        out[(i, j)].to_bits(),
+                        sequential[(i, j)].to_bits(),
+                        "row {i}, column {j}, {threads} threads"
+                    );
+                }
+            }
+        }
+    }
 }
