@@ -212,37 +212,47 @@ fn probed_clusters(
     probes: usize,
     count: usize,
 ) -> Vec<Vec<u32>> {
+    let cmp = |x: &(f64, u32), y: &(f64, u32)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
     let starts: Vec<usize> = (0..rows.nrows()).step_by(1024).collect();
     starts
         .par_iter()
         .flat_map_iter(|&r0| {
             let m = 1024.min(rows.nrows() - r0);
-            let d = dots(rows.subrows(r0, m), c.centres.as_ref());
-            let mut order: Vec<(f64, u32)> = Vec::with_capacity(c.centre_norms.len());
+            // Centres × rows, so that each row's distances are one contiguous column.
+            let d = dots(c.centres.as_ref(), rows.subrows(r0, m));
+            let mut nearest: Vec<(f64, u32)> = Vec::with_capacity(probes + 1);
             (0..m)
                 .map(|i| {
-                    order.clear();
-                    order.extend(
-                        c.centre_norms
-                            .iter()
-                            .enumerate()
-                            .map(|(j, &cn)| (cn - 2.0 * d[(i, j)], j as u32)),
-                    );
-                    let cmp =
-                        |x: &(f64, u32), y: &(f64, u32)| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1));
-                    // Most rows need only their `probes` nearest: select, then sort those.
-                    let first = probes.min(order.len());
-                    if first < order.len() {
-                        order.select_nth_unstable_by(first, cmp);
+                    let col = d.col(i).try_as_col_major().expect("owned").as_slice();
+                    // The `probes` nearest centres by one pass that keeps them sorted: most
+                    // centres are rejected by one comparison with the farthest kept.
+                    nearest.clear();
+                    for (j, (&cn, &dot)) in c.centre_norms.iter().zip(col).enumerate() {
+                        let x = (cn - 2.0 * dot, j as u32);
+                        if nearest.len() == probes
+                            && cmp(&x, &nearest[probes - 1]) != std::cmp::Ordering::Less
+                        {
+                            continue;
+                        }
+                        let at = nearest.partition_point(|y| cmp(y, &x).is_lt());
+                        nearest.insert(at, x);
+                        nearest.truncate(probes);
                     }
-                    order[..first].sort_unstable_by(cmp);
-                    let mut held: usize = order[..first]
+                    let mut held: usize = nearest
                         .iter()
                         .map(|&(_, j)| c.members[j as usize].len())
                         .sum();
-                    let mut out: Vec<u32> = order[..first].iter().map(|&(_, j)| j).collect();
+                    let mut out: Vec<u32> = nearest.iter().map(|&(_, j)| j).collect();
                     if held < count {
-                        let mut rest = order[first..].to_vec();
+                        // Rare (small clusters): every other centre, nearest first.
+                        let mut rest: Vec<(f64, u32)> = c
+                            .centre_norms
+                            .iter()
+                            .zip(col)
+                            .enumerate()
+                            .map(|(j, (&cn, &dot))| (cn - 2.0 * dot, j as u32))
+                            .filter(|x| nearest.iter().all(|y| y.1 != x.1))
+                            .collect();
                         rest.sort_unstable_by(cmp);
                         for &(_, j) in &rest {
                             if held >= count {
