@@ -175,7 +175,25 @@ fn brute_force_candidates(
                 (Vec::with_capacity(m * count), Vec::with_capacity(m * count));
             let mut top = TopK::new(count);
             for (j, &q_norm) in q_norms.iter().enumerate() {
-                let col = dots.col(j);
+                let col = dots.col(j).try_as_col_major().expect("owned").as_slice();
+                if count == 1 {
+                    // ZoomOut's steps ask for the nearest row only: a plain minimum, with
+                    // `TopK`'s rules (NaN ranks last, ties to the lowest index).
+                    let key = |i: usize| {
+                        let d = norms[i] - 2.0 * col[i];
+                        if d.is_nan() { f64::INFINITY } else { d }
+                    };
+                    let mut best = (key(0), 0usize);
+                    for i in 1..n {
+                        let d = key(i);
+                        if d < best.0 {
+                            best = (d, i);
+                        }
+                    }
+                    targets.push(best.1 as u32);
+                    costs.push((best.0 + q_norm).max(0.0));
+                    continue;
+                }
                 top.clear();
                 // `‖a‖² − 2 a·q` orders the rows as the squared distance does; `‖q‖²` is added
                 // to the kept ones only.
@@ -431,6 +449,26 @@ mod tests {
         }
         let recall = found as f64 / (700 * 16) as f64;
         assert!(recall > 0.99, "recall {recall}");
+    }
+
+    /// The nearest-only path agrees with the first of the k-nearest lists, ties (every base
+    /// row twice) and a NaN row included.
+    #[test]
+    fn the_nearest_alone_is_the_first_of_the_nearest_lists() {
+        let half = sheet(300, 5);
+        let mut base = Mat::from_fn(600, 40, |i, j| half[(i % 300, j)]);
+        base[(7, 3)] = f64::NAN;
+        let query = sheet(150, 6);
+        let one = brute_force_candidates(base.as_ref(), query.as_ref(), 1);
+        let four = brute_force_candidates(base.as_ref(), query.as_ref(), 4);
+        for q in 0..150 {
+            assert_eq!(one.targets[q], four.targets[q * 4], "query {q}");
+            assert_eq!(one.costs[q].to_bits(), four.costs[q * 4].to_bits());
+            assert!(one.targets[q] < 300, "a tie goes to the lower copy");
+        }
+        let nan_query = Mat::from_fn(1, 40, |_, _| f64::NAN);
+        let lists = brute_force_candidates(base.as_ref(), nan_query.as_ref(), 1);
+        assert_eq!(lists.targets, vec![0]);
     }
 
     #[test]
