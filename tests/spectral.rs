@@ -783,7 +783,13 @@ mod auction {
             raw in proptest::collection::vec(0.0f64..10.0, 49),
         ) {
             let costs = &raw[..n * n];
-            let options = { let mut opts = AuctionOptions::default(); opts.penalty = 1e9; opts };
+            for scaling in [true, false] {
+            let options = {
+                let mut opts = AuctionOptions::default();
+                opts.penalty = 1e9;
+                opts.epsilon_scaling = scaling;
+                opts
+            };
             let candidates = lists(costs, n);
             let out = auction_assignment(&candidates, n, &options).unwrap();
             let mut seen = out.map.clone();
@@ -797,9 +803,51 @@ mod auction {
             let got = total(costs, n, &out.map);
             prop_assert!(
                 got <= optimum + n as f64 * options.epsilon * scale + 1e-9,
-                "cost {} against the optimum {}", got, optimum
+                "cost {} against the optimum {} (ε-scaling {})", got, optimum, scaling
+            );
+            }
+        }
+    }
+
+    /// ε-scaling: where queries crowd a few targets the prices climb in coarse steps first,
+    /// so the bidding takes far fewer bids; and the reverse bids leave no slot of the crowded
+    /// targets empty (the coarse phase alone left all 24 empty).
+    #[test]
+    fn epsilon_scaling_cuts_the_bids_of_a_crowded_region() {
+        // 60 queries, 40 targets (capacity 2); every query's 8 candidates lie among the
+        // first 12 targets at nearly equal costs: 24 slots for 60 queries.
+        let (queries, targets, per) = (60usize, 40usize, 8usize);
+        let mut lists = CandidateLists {
+            per_query: per,
+            targets: vec![],
+            costs: vec![],
+        };
+        for q in 0..queries {
+            for j in 0..per {
+                lists.targets.push(((q + 3 * j) % 12) as u32);
+                lists
+                    .costs
+                    .push(1.0 + 0.01 * j as f64 + 0.001 * (q % 7) as f64);
+            }
+        }
+        let run = |scaling: bool| {
+            let mut opts = AuctionOptions::default();
+            opts.epsilon_scaling = scaling;
+            auction_assignment(&lists, targets, &opts).unwrap()
+        };
+        let (plain, scaled) = (run(false), run(true));
+        for out in [&plain, &scaled] {
+            assert_eq!(
+                out.exclusive, 24,
+                "every slot of the 12 crowded targets is taken"
             );
         }
+        assert!(
+            scaled.bids * 2 < plain.bids,
+            "bids: {} with ε-scaling, {} without",
+            scaled.bids,
+            plain.bids
+        );
     }
 
     #[test]
