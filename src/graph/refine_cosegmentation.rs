@@ -5,7 +5,7 @@ use super::shape_graph::ShapeGraph;
 use super::{Cosegmentation, GraphError};
 use crate::affinity::kernel::{Block, LANES, row_sum};
 use crate::spectral::HeatSmoother;
-use crate::stable::{RefineOptions, StableError, assign_regions};
+use crate::stable::{RefineOptions, StableError, assign_regions, best_two};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -276,17 +276,7 @@ fn assign_sized(
     let mut labels = vec![0i32; d];
     let mut margins = vec![0.0; d];
     for q in 0..d {
-        let (mut best, mut second, mut arg) = (f64::NEG_INFINITY, f64::NEG_INFINITY, 0usize);
-        for (r, &th) in theta.iter().enumerate() {
-            let s = log(r, q) + th;
-            if s > best {
-                second = best;
-                best = s;
-                arg = r;
-            } else if s > second {
-                second = s;
-            }
-        }
+        let (best, second, arg) = best_two(theta.iter().enumerate().map(|(r, &th)| log(r, q) + th));
         labels[q] = arg as i32;
         // (best − second) / best of the scaled scores exp(s): 1 − exp(second − best).
         margins[q] = if best.is_finite() {

@@ -6,7 +6,7 @@ use super::{PartScore, PropagateError, PropagateOptions};
 use crate::affinity::{BandAffinity, Direction, FeaturePairing};
 use crate::graph::ShapeGraph;
 use crate::spectral::HeatSmoother;
-use crate::stable::region_scores;
+use crate::stable::{best_two, region_scores};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
@@ -698,17 +698,7 @@ fn fit_sizes(
         let mut margins = vec![0.0; d];
         let mut shares = vec![0.0; np];
         for q in 0..d {
-            let (mut best, mut second, mut arg) = (f64::NEG_INFINITY, f64::NEG_INFINITY, 0);
-            for r in 0..np {
-                let s = scores[r * d + q] * scale[r];
-                if s > best {
-                    second = best;
-                    best = s;
-                    arg = r;
-                } else if s > second {
-                    second = s;
-                }
-            }
+            let (best, second, arg) = best_two((0..np).map(|r| scores[r * d + q] * scale[r]));
             labels[q] = arg as i32;
             margins[q] = if best > 0.0 {
                 ((best - second.max(0.0)) / best).clamp(0.0, 1.0)

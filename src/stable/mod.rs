@@ -34,6 +34,7 @@ pub use correspondence_ratio::{
 };
 pub use initial_indicator::{Init, initial_indicator};
 pub use map_guided_refinement::{map_guided_refinement, point_map_refinement};
+pub(crate) use refine_partition::best_two;
 pub use refine_partition::{
     RefineOptions, RefinedPartition, assign_regions, refine_partition, region_scores,
 };

@@ -140,17 +140,7 @@ pub fn assign_regions(
     let mut labels = vec![0i32; d];
     let mut margins = vec![0.0; d];
     for q in 0..d {
-        let (mut best, mut second, mut arg) = (f64::NEG_INFINITY, f64::NEG_INFINITY, 0usize);
-        for r in 0..regions {
-            let s = scores[r * d + q];
-            if s > best {
-                second = best;
-                best = s;
-                arg = r;
-            } else if s > second {
-                second = s;
-            }
-        }
+        let (best, second, arg) = best_two((0..regions).map(|r| scores[r * d + q]));
         labels[q] = arg as i32;
         margins[q] = if best > 0.0 {
             ((best - second.max(0.0)) / best).clamp(0.0, 1.0)
@@ -253,4 +243,21 @@ pub fn refine_partition(
         rounds,
         converged,
     })
+}
+
+/// The largest and the second-largest of `scores` and the index of the largest (the first of
+/// equals; a NaN never wins), `(-∞, -∞, 0)` when empty: a vertex's winning region and the two
+/// values its margin is made of, for every best-response assignment.
+pub(crate) fn best_two(scores: impl IntoIterator<Item = f64>) -> (f64, f64, usize) {
+    let (mut best, mut second, mut arg) = (f64::NEG_INFINITY, f64::NEG_INFINITY, 0usize);
+    for (r, s) in scores.into_iter().enumerate() {
+        if s > best {
+            second = best;
+            best = s;
+            arg = r;
+        } else if s > second {
+            second = s;
+        }
+    }
+    (best, second, arg)
 }
