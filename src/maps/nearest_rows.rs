@@ -9,10 +9,14 @@
 //! exact: a candidate in an unprobed cluster is missed. The triangle-inequality bound that
 //! would make it exact prunes nothing on these embeddings (the descriptor columns are noisy),
 //! measured on victoria0 × david0.
+//!
+//! The base is reordered in place cluster by cluster and the query rows are read a block at a
+//! time through [`QueryRows`], so the search holds no copy of either (docs/PERFORMANCE.md,
+//! "Fourth pass").
 
 use super::CandidateLists;
 use faer::linalg::matmul::matmul;
-use faer::{Accum, Mat, MatRef, Par};
+use faer::{Accum, Mat, MatMut, MatRef, Par};
 use rayon::prelude::*;
 
 /// Rows of `query` per block of the brute-force search: fixed, so the result does not depend
@@ -47,13 +51,62 @@ pub fn nearest_candidates(
     query: MatRef<'_, f64>,
     count: usize,
 ) -> CandidateLists {
-    let n = base.nrows();
-    let finite =
-        |m: MatRef<'_, f64>| (0..m.ncols()).all(|j| m.col(j).iter().all(|x| x.is_finite()));
-    if n >= PRUNE_FROM && query.nrows() > 0 && finite(base) && finite(query) {
+    if clustered(base, &query) {
+        clustered_candidates(base.to_owned(), &query, count)
+    } else {
+        brute_force_candidates(base, &query, count)
+    }
+}
+
+/// [`nearest_candidates`] with a base it may reorder in place (the clustered search sorts
+/// the base rows by cluster, which saves a copy as large as the base).
+pub(crate) fn nearest_candidates_owned<Q: QueryRows + ?Sized>(
+    base: Mat<f64>,
+    query: &Q,
+    count: usize,
+) -> CandidateLists {
+    if clustered(base.as_ref(), query) {
         clustered_candidates(base, query, count)
     } else {
-        brute_force_candidates(base, query, count)
+        brute_force_candidates(base.as_ref(), query, count)
+    }
+}
+
+/// Whether [`nearest_candidates`] takes the clustered search: a large base, and no NaN
+/// (whose ranking the centre distances cannot follow).
+fn clustered<Q: QueryRows + ?Sized>(base: MatRef<'_, f64>, query: &Q) -> bool {
+    base.nrows() >= PRUNE_FROM && query.nrows() > 0 && base.is_finite() && query.is_finite()
+}
+
+/// The rows a search compares with the base, read a block of rows at a time: a matrix, or
+/// an embedding assembled block by block (ZoomOut's last match never holds B's whole
+/// embedding, 190 MB on a 50k-vertex shape).
+pub(crate) trait QueryRows: Sync {
+    /// Number of rows.
+    fn nrows(&self) -> usize;
+    /// The rows `rows`, in that order (`rows.len() ×` the number of columns).
+    fn rows(&self, rows: &[usize]) -> Mat<f64>;
+    /// Whether every entry is finite.
+    fn is_finite(&self) -> bool {
+        let n = self.nrows();
+        (0..n).step_by(4096).all(|r0| {
+            let block = self.rows(&(r0..n.min(r0 + 4096)).collect::<Vec<_>>());
+            (0..block.ncols()).all(|j| block.col(j).iter().all(|x| x.is_finite()))
+        })
+    }
+}
+
+impl QueryRows for MatRef<'_, f64> {
+    fn nrows(&self) -> usize {
+        MatRef::nrows(self)
+    }
+
+    fn rows(&self, rows: &[usize]) -> Mat<f64> {
+        gather_rows(*self, rows)
+    }
+
+    fn is_finite(&self) -> bool {
+        (0..self.ncols()).all(|j| self.col(j).iter().all(|x| x.is_finite()))
     }
 }
 
@@ -75,11 +128,18 @@ fn row_norms(m: MatRef<'_, f64>) -> Vec<f64> {
 /// TOSCA pair, measured with `perf`).
 pub(crate) fn gather_rows(m: MatRef<'_, f64>, rows: &[usize]) -> Mat<f64> {
     let mut out = Mat::<f64>::zeros(rows.len(), m.ncols());
+    gather_rows_into(out.as_mut(), m, rows);
+    out
+}
+
+/// [`gather_rows`] into `out` (`rows.len() × m.ncols()`, column-major).
+pub(crate) fn gather_rows_into(mut out: MatMut<'_, f64>, m: MatRef<'_, f64>, rows: &[usize]) {
     for j in 0..m.ncols() {
         let dst = out
+            .as_mut()
             .col_mut(j)
             .try_as_col_major_mut()
-            .expect("owned")
+            .expect("column-major")
             .as_slice_mut();
         match m.col(j).try_as_col_major() {
             Some(src) => {
@@ -96,25 +156,41 @@ pub(crate) fn gather_rows(m: MatRef<'_, f64>, rows: &[usize]) -> Mat<f64> {
             }
         }
     }
+}
+
+/// `m` in single precision, column by column.
+fn single(m: MatRef<'_, f64>) -> Mat<f32> {
+    let mut out = Mat::<f32>::zeros(m.nrows(), m.ncols());
+    for j in 0..m.ncols() {
+        let dst = out
+            .col_mut(j)
+            .try_as_col_major_mut()
+            .expect("owned")
+            .as_slice_mut();
+        for (d, &x) in dst.iter_mut().zip(m.col(j).iter()) {
+            *d = x as f32;
+        }
+    }
     out
 }
 
 /// `out = a · bᵀ` (`a.nrows() × b.nrows()`), sequential.
-fn dots(a: MatRef<'_, f64>, b: MatRef<'_, f64>) -> Mat<f64> {
-    let mut out = Mat::<f64>::zeros(a.nrows(), b.nrows());
+fn dots<T: faer::traits::ComplexField>(a: MatRef<'_, T>, b: MatRef<'_, T>) -> Mat<T> {
+    let mut out = Mat::<T>::zeros(a.nrows(), b.nrows());
     matmul(
         out.as_mut(),
         Accum::Replace,
         a,
         b.transpose(),
-        1.0,
+        T::one_impl(),
         Par::Seq,
     );
     out
 }
 
-/// A query and its nearest rows, as `(‖a‖² − 2 a·q, a)` pairs, nearest first.
-type Neighbours = (u32, Vec<(f64, u32)>);
+/// A query, its squared norm and its nearest rows, as `(‖a‖² − 2 a·q, a)` pairs, nearest
+/// first.
+type Neighbours = (u32, f64, Vec<(f64, u32)>);
 
 /// Keeps the `count` smallest `(d, index)` pairs of a stream, sorted ascending.
 struct TopK {
@@ -155,9 +231,9 @@ impl TopK {
 }
 
 /// Every base row against every query row, in fixed query blocks.
-fn brute_force_candidates(
+fn brute_force_candidates<Q: QueryRows + ?Sized>(
     base: MatRef<'_, f64>,
-    query: MatRef<'_, f64>,
+    query: &Q,
     count: usize,
 ) -> CandidateLists {
     let n = base.nrows();
@@ -168,9 +244,9 @@ fn brute_force_candidates(
         .par_iter()
         .map(|&r0| {
             let m = QUERY_BLOCK.min(query.nrows() - r0);
-            let block = query.subrows(r0, m);
-            let dots = dots(base, block);
-            let q_norms = row_norms(block);
+            let block = query.rows(&(r0..r0 + m).collect::<Vec<_>>());
+            let dots = dots(base, block.as_ref());
+            let q_norms = row_norms(block.as_ref());
             let (mut targets, mut costs) =
                 (Vec::with_capacity(m * count), Vec::with_capacity(m * count));
             let mut top = TopK::new(count);
@@ -213,19 +289,41 @@ fn brute_force_candidates(
     }
 }
 
-/// Base rows grouped into clusters around fixed centres (every `n / C`-th row).
+/// Base rows grouped into clusters around fixed centres (every `n / C`-th row), the base
+/// reordered so that every cluster is one run of rows.
 struct Clusters {
-    /// `C × D` centre rows.
-    centres: Mat<f64>,
+    /// `C × D` centre rows, in single precision: they only rank centres (see
+    /// [`probed_clusters`]).
+    centres: Mat<f32>,
     centre_norms: Vec<f64>,
-    /// Members of every cluster, ascending.
-    members: Vec<Vec<u32>>,
+    /// Cluster `j` is rows `starts[j]..starts[j + 1]` of the reordered base (`C + 1`).
+    starts: Vec<usize>,
+    /// The original index of every row of the reordered base: clusters in order, each
+    /// cluster's members ascending.
+    original: Vec<u32>,
+}
+
+impl Clusters {
+    fn count(&self) -> usize {
+        self.starts.len() - 1
+    }
+
+    fn size(&self, j: usize) -> usize {
+        self.starts[j + 1] - self.starts[j]
+    }
 }
 
 /// For every row of `rows`, its clusters nearest first (ties to the lowest) until they hold
 /// `count` members and number at least `probes`.
-fn probed_clusters(
-    rows: MatRef<'_, f64>,
+///
+/// The centre distances are products in single precision (`‖c‖²` stays double): they only
+/// choose which clusters a row is compared with, and the comparisons themselves are in double
+/// precision. That halved the cost of clustering and probing (half of the search on
+/// victoria0 × david0) and left the pair's regions unchanged there and on dog0 × cat0;
+/// where two centres are within single-precision rounding of each other the other may be
+/// probed.
+fn probed_clusters<R: QueryRows + ?Sized>(
+    rows: &R,
     c: &Clusters,
     probes: usize,
     count: usize,
@@ -237,7 +335,9 @@ fn probed_clusters(
         .flat_map_iter(|&r0| {
             let m = 1024.min(rows.nrows() - r0);
             // Centres × rows, so that each row's distances are one contiguous column.
-            let d = dots(c.centres.as_ref(), rows.subrows(r0, m));
+            let block = rows.rows(&(r0..r0 + m).collect::<Vec<_>>());
+            let block = single(block.as_ref());
+            let d = dots(c.centres.as_ref(), block.as_ref());
             let mut nearest: Vec<(f64, u32)> = Vec::with_capacity(probes + 1);
             (0..m)
                 .map(|i| {
@@ -246,7 +346,7 @@ fn probed_clusters(
                     // centres are rejected by one comparison with the farthest kept.
                     nearest.clear();
                     for (j, (&cn, &dot)) in c.centre_norms.iter().zip(col).enumerate() {
-                        let x = (cn - 2.0 * dot, j as u32);
+                        let x = (cn - 2.0 * f64::from(dot), j as u32);
                         if nearest.len() == probes
                             && cmp(&x, &nearest[probes - 1]) != std::cmp::Ordering::Less
                         {
@@ -256,10 +356,7 @@ fn probed_clusters(
                         nearest.insert(at, x);
                         nearest.truncate(probes);
                     }
-                    let mut held: usize = nearest
-                        .iter()
-                        .map(|&(_, j)| c.members[j as usize].len())
-                        .sum();
+                    let mut held: usize = nearest.iter().map(|&(_, j)| c.size(j as usize)).sum();
                     let mut out: Vec<u32> = nearest.iter().map(|&(_, j)| j).collect();
                     if held < count {
                         // Rare (small clusters): every other centre, nearest first.
@@ -268,7 +365,7 @@ fn probed_clusters(
                             .iter()
                             .zip(col)
                             .enumerate()
-                            .map(|(j, (&cn, &dot))| (cn - 2.0 * dot, j as u32))
+                            .map(|(j, (&cn, &dot))| (cn - 2.0 * f64::from(dot), j as u32))
                             .filter(|x| nearest.iter().all(|y| y.1 != x.1))
                             .collect();
                         rest.sort_unstable_by(cmp);
@@ -277,7 +374,7 @@ fn probed_clusters(
                                 break;
                             }
                             out.push(j);
-                            held += c.members[j as usize].len();
+                            held += c.size(j as usize);
                         }
                     }
                     out
@@ -287,34 +384,63 @@ fn probed_clusters(
         .collect()
 }
 
-fn clusters(base: MatRef<'_, f64>) -> Clusters {
+/// Clusters `base` and reorders its rows in place, cluster by cluster.
+///
+/// Why reorder: a group of queries searches ~10 clusters of ~64 rows; gathering those rows
+/// from a column-major base one by one was a tenth of `coseg pair`'s CPU on the 50k-vertex
+/// TOSCA pair (`perf`), and runs of rows copy as whole cache lines.
+fn clusters(base: &mut Mat<f64>) -> Clusters {
     let n = base.nrows();
     let count = (n / CLUSTER_SIZE).max(1);
     let rows: Vec<usize> = (0..count).map(|i| i * n / count).collect();
-    let centres = gather_rows(base, &rows);
+    let centres = gather_rows(base.as_ref(), &rows);
     let centre_norms = row_norms(centres.as_ref());
+    let centres = single(centres.as_ref());
     let mut c = Clusters {
         centres,
         centre_norms,
-        members: vec![Vec::new(); count],
+        starts: vec![0; count + 1],
+        original: Vec::new(),
     };
-    for (v, nearest) in probed_clusters(base, &c, 1, 0).into_iter().enumerate() {
-        c.members[nearest[0] as usize].push(v as u32);
+    let nearest: Vec<u32> = probed_clusters(&base.as_ref(), &c, 1, 0)
+        .into_iter()
+        .map(|p| p[0])
+        .collect();
+    for &j in &nearest {
+        c.starts[j as usize + 1] += 1;
     }
+    for j in 0..count {
+        c.starts[j + 1] += c.starts[j];
+    }
+    let mut next = c.starts.clone();
+    c.original = vec![0; n];
+    for (v, &j) in nearest.iter().enumerate() {
+        c.original[next[j as usize]] = v as u32;
+        next[j as usize] += 1;
+    }
+    let original = &c.original;
+    base.as_mut().par_col_iter_mut().for_each(|col| {
+        let col = col.try_as_col_major_mut().expect("owned").as_slice_mut();
+        let old = col.to_vec();
+        for (x, &o) in col.iter_mut().zip(original) {
+            *x = old[o as usize];
+        }
+    });
     c
 }
 
 /// The clustered search (an inverted file): queries are grouped by their nearest centre;
 /// every query's candidates are the members of its `PROBES` nearest clusters (by centre
 /// distance), and a group searches the union of its queries' clusters exactly.
-fn clustered_candidates(
-    base: MatRef<'_, f64>,
-    query: MatRef<'_, f64>,
+fn clustered_candidates<Q: QueryRows + ?Sized>(
+    mut base: Mat<f64>,
+    query: &Q,
     count: usize,
 ) -> CandidateLists {
     let n = base.nrows();
     let count = count.min(n).max(1);
-    let c = clusters(base);
+    let c = clusters(&mut base);
+    let base = base.as_ref();
     let norms = row_norms(base);
     let probes = probed_clusters(query, &c, PROBES, count);
     let mut by_centre: Vec<(u32, u32)> = probes
@@ -333,11 +459,8 @@ fn clustered_candidates(
         .collect();
     let mut targets = vec![0u32; query.nrows() * count];
     let mut costs = vec![f64::INFINITY; query.nrows() * count];
-    for (q, best) in per_group.into_iter().flatten() {
+    for (q, q_norm, best) in per_group.into_iter().flatten() {
         let at = q as usize * count;
-        let q_norm: f64 = (0..query.ncols())
-            .map(|j| query[(q as usize, j)].powi(2))
-            .sum();
         for (s, &(d, i)) in best.iter().enumerate() {
             targets[at + s] = i;
             costs[at + s] = (d + q_norm).max(0.0);
@@ -356,11 +479,32 @@ fn clustered_candidates(
     }
 }
 
+/// The `count` smallest `(d, index)` pairs of `all`, ascending, with [`TopK`]'s order (a NaN
+/// ranks as +∞, equal distances by index): one selection and a sort of the kept, cheaper than
+/// offering the ~640 candidates of a clustered query one by one.
+fn smallest(all: &mut [(f64, u32)], count: usize) -> Vec<(f64, u32)> {
+    for x in all.iter_mut() {
+        if x.0.is_nan() {
+            x.0 = f64::INFINITY;
+        }
+    }
+    let order =
+        |x: &(f64, u32), y: &(f64, u32)| x.0.partial_cmp(&y.0).expect("no NaN").then(x.1.cmp(&y.1));
+    let kept = count.min(all.len());
+    if kept > 0 && kept < all.len() {
+        all.select_nth_unstable_by(kept - 1, order);
+    }
+    let mut best = all[..kept].to_vec();
+    best.sort_unstable_by(order);
+    best
+}
+
 /// One group of queries (`(centre, query)` pairs): their `count` nearest rows among the
-/// members of their clusters, as `(‖a‖² − 2 a·q, a)` pairs.
-fn search_group(
+/// members of their clusters, as `(‖a‖² − 2 a·q, a)` pairs (`a` the original index). `base`
+/// and `norms` are in the clusters' order.
+fn search_group<Q: QueryRows + ?Sized>(
     base: MatRef<'_, f64>,
-    query: MatRef<'_, f64>,
+    query: &Q,
     norms: &[f64],
     c: &Clusters,
     probes: &[Vec<u32>],
@@ -368,32 +512,63 @@ fn search_group(
     count: usize,
 ) -> Vec<Neighbours> {
     let rows: Vec<usize> = group.iter().map(|&(_, q)| q as usize).collect();
-    let rows = gather_rows(query, &rows);
-    let clusters = c.members.len();
+    let rows = query.rows(&rows);
+    let q_norms = row_norms(rows.as_ref());
+    let clusters = c.count();
     let mut needed = vec![false; clusters];
     for &(_, q) in group {
         for &j in &probes[q as usize] {
             needed[j as usize] = true;
         }
     }
-    let chosen: Vec<u32> = (0..clusters)
-        .filter(|&j| needed[j])
-        .flat_map(|j| c.members[j].iter().copied())
-        .collect();
-    let chosen_rows: Vec<usize> = chosen.iter().map(|&a| a as usize).collect();
-    let candidates = gather_rows(base, &chosen_rows);
+    // Runs of the reordered base, adjacent clusters merged.
+    let mut runs: Vec<(usize, usize)> = Vec::new();
+    for j in (0..clusters).filter(|&j| needed[j]) {
+        let (s, e) = (c.starts[j], c.starts[j + 1]);
+        match runs.last_mut() {
+            Some(last) if last.1 == s => last.1 = e,
+            _ => runs.push((s, e)),
+        }
+    }
+    let total: usize = runs.iter().map(|r| r.1 - r.0).sum();
+    let mut candidates = Mat::<f64>::zeros(total, base.ncols());
+    for j in 0..base.ncols() {
+        let src = base.col(j).try_as_col_major().expect("owned").as_slice();
+        let dst = candidates
+            .col_mut(j)
+            .try_as_col_major_mut()
+            .expect("owned")
+            .as_slice_mut();
+        let mut at = 0;
+        for &(s, e) in &runs {
+            dst[at..at + e - s].copy_from_slice(&src[s..e]);
+            at += e - s;
+        }
+    }
     let d = dots(candidates.as_ref(), rows.as_ref());
-    let mut top = TopK::new(count);
+    let original: Vec<u32> = runs
+        .iter()
+        .flat_map(|&(r0, r1)| c.original[r0..r1].iter().copied())
+        .collect();
+    let chosen_norms: Vec<f64> = runs
+        .iter()
+        .flat_map(|&(r0, r1)| norms[r0..r1].iter().copied())
+        .collect();
+    let mut all: Vec<(f64, u32)> = Vec::with_capacity(total);
     group
         .iter()
         .enumerate()
         .map(|(g, &(_, q))| {
-            top.clear();
-            let col = d.col(g);
-            for (s, &a) in chosen.iter().enumerate() {
-                top.offer(norms[a as usize] - 2.0 * col[s], a);
-            }
-            (q, top.best.clone())
+            let col = d.col(g).try_as_col_major().expect("owned").as_slice();
+            all.clear();
+            all.extend(
+                chosen_norms
+                    .iter()
+                    .zip(col)
+                    .zip(&original)
+                    .map(|((&norm, &dot), &a)| (norm - 2.0 * dot, a)),
+            );
+            (q, q_norms[g], smallest(&mut all, count))
         })
         .collect()
 }
@@ -422,8 +597,8 @@ mod tests {
     fn clustered_search_finds_nearly_all_brute_force_candidates() {
         let base = sheet(9000, 1);
         let query = sheet(700, 2);
-        let brute = brute_force_candidates(base.as_ref(), query.as_ref(), 16);
-        let clustered = clustered_candidates(base.as_ref(), query.as_ref(), 16);
+        let brute = brute_force_candidates(base.as_ref(), &query.as_ref(), 16);
+        let clustered = clustered_candidates(base.clone(), &query.as_ref(), 16);
         assert_eq!(clustered.per_query, 16);
         let mut found = 0;
         for q in 0..700 {
@@ -459,16 +634,46 @@ mod tests {
         let mut base = Mat::from_fn(600, 40, |i, j| half[(i % 300, j)]);
         base[(7, 3)] = f64::NAN;
         let query = sheet(150, 6);
-        let one = brute_force_candidates(base.as_ref(), query.as_ref(), 1);
-        let four = brute_force_candidates(base.as_ref(), query.as_ref(), 4);
+        let one = brute_force_candidates(base.as_ref(), &query.as_ref(), 1);
+        let four = brute_force_candidates(base.as_ref(), &query.as_ref(), 4);
         for q in 0..150 {
             assert_eq!(one.targets[q], four.targets[q * 4], "query {q}");
             assert_eq!(one.costs[q].to_bits(), four.costs[q * 4].to_bits());
             assert!(one.targets[q] < 300, "a tie goes to the lower copy");
         }
         let nan_query = Mat::from_fn(1, 40, |_, _| f64::NAN);
-        let lists = brute_force_candidates(base.as_ref(), nan_query.as_ref(), 1);
+        let lists = brute_force_candidates(base.as_ref(), &nan_query.as_ref(), 1);
         assert_eq!(lists.targets, vec![0]);
+    }
+
+    /// The selection the clustered search keeps its candidates by agrees with `TopK`, ties,
+    /// NaN, signed zeros and lists shorter than `count` included.
+    #[test]
+    fn smallest_keeps_what_top_k_keeps() {
+        let mut rng = ChaCha8Rng::seed_from_u64(7);
+        for round in 0..200 {
+            let len = (rng.next_u64() % 90) as usize;
+            let count = 1 + (rng.next_u64() % 70) as usize;
+            let all: Vec<(f64, u32)> = (0..len)
+                .map(|i| {
+                    let d = match rng.next_u64() % 10 {
+                        0 => f64::NAN,
+                        1 => -0.0,
+                        2 => 0.0,
+                        r => (r % 4) as f64 - 1.5,
+                    };
+                    (d, (i as u32 * 7919) % 1000)
+                })
+                .collect();
+            let mut top = TopK::new(count);
+            for &(d, i) in &all {
+                top.offer(d, i);
+            }
+            let got = smallest(&mut all.clone(), count);
+            let bits =
+                |v: &[(f64, u32)]| v.iter().map(|x| (x.0.to_bits(), x.1)).collect::<Vec<_>>();
+            assert_eq!(bits(&got), bits(&top.best), "round {round}");
+        }
     }
 
     #[test]
@@ -478,8 +683,8 @@ mod tests {
         let base = Mat::from_fn(9000, 40, |i, j| half[(i % 4500, j)]);
         let query = sheet(200, 4);
         for lists in [
-            brute_force_candidates(base.as_ref(), query.as_ref(), 8),
-            clustered_candidates(base.as_ref(), query.as_ref(), 8),
+            brute_force_candidates(base.as_ref(), &query.as_ref(), 8),
+            clustered_candidates(base.clone(), &query.as_ref(), 8),
         ] {
             for list in lists.targets.chunks(8) {
                 for w in list.chunks(2) {

@@ -1,7 +1,7 @@
 //! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
 //! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
 
-use super::nearest_rows::gather_rows;
+use super::nearest_rows::{QueryRows, gather_rows, gather_rows_into, nearest_candidates_owned};
 use super::{AuctionOptions, CandidateLists, auction_assignment};
 use crate::spectral::{SpectralError, Spectrum};
 use faer::linalg::matmul::matmul;
@@ -270,66 +270,89 @@ pub(crate) fn zoomout_from(
     match (a.descriptors, b.descriptors) {
         (Some(da), Some(db)) if lambda > 0.0 => {
             let w = options.descriptor_weights.as_deref();
-            let (base, query) = rayon::join(
-                || with_descriptors(Embedding::PulledBack(phi_a, &c), da, lambda, w),
-                || with_descriptors(Embedding::Plain(phi_b.subcols(0, k)), db, lambda, w),
-            );
-            final_point_map(&base, query.as_ref(), &options.final_match)
+            let base = with_descriptors(phi_a, &c, da, lambda, w);
+            let query = WithDescriptors {
+                x: phi_b.subcols(0, k),
+                descriptors: db,
+                scales: descriptor_scales(db, phi_b.nrows(), lambda, w),
+            };
+            final_point_map(base, &query, &options.final_match)
         }
         _ => final_point_map(
-            &pulled_back(phi_a, &c),
-            phi_b.subcols(0, k),
+            pulled_back(phi_a, &c),
+            &phi_b.subcols(0, k),
             &options.final_match,
         ),
     }
 }
 
 /// The last point map: rows of `query` (B) to rows of `base` (A).
-fn final_point_map(
-    base: &Mat<f64>,
-    query: MatRef<'_, f64>,
+fn final_point_map<Q: QueryRows + ?Sized>(
+    base: Mat<f64>,
+    query: &Q,
     final_match: &FinalMatch,
 ) -> Result<Vec<u32>, SpectralError> {
     match final_match {
-        FinalMatch::Nearest => Ok(nearest_rows(base, query)),
+        FinalMatch::Nearest => Ok(nearest_candidates_owned(base, query, 1).targets),
         FinalMatch::Bijective {
             candidates,
             auction,
         } => {
-            let lists = nearest_candidates(base, query, *candidates);
-            Ok(auction_assignment(&lists, base.nrows(), auction)?.map)
+            let n = base.nrows();
+            let lists = nearest_candidates_owned(base, query, *candidates);
+            Ok(auction_assignment(&lists, n, auction)?.map)
         }
     }
 }
 
-/// The spectral part of a last-match embedding.
-enum Embedding<'a> {
-    /// These coordinates as they are (B's `Φ_B`).
-    Plain(MatRef<'a, f64>),
-    /// `Φ Cᵀ` ([`pulled_back`]; A's).
-    PulledBack(MatRef<'a, f64>, &'a DMatrix<f64>),
+/// B's last-match embedding `[x | λ D̂]` ([`with_descriptors`]), assembled a block of rows at
+/// a time by the search instead of held whole.
+struct WithDescriptors<'a> {
+    /// `d × k` spectral coordinates.
+    x: MatRef<'a, f64>,
+    /// `d × n`, column-major.
+    descriptors: &'a [f64],
+    /// [`descriptor_scales`] (`n`).
+    scales: Vec<f64>,
 }
 
-/// `[x | λ D̂]`: the spectral coordinates `x` (`d × k`) with the descriptors appended as
-/// columns, each scaled to unit Euclidean norm and then by `λ` (and by `√(w_j / mean w)` with
-/// per-column weights). Written in place: one `d × (k + n)` matrix, no intermediate.
-fn with_descriptors(
-    x: Embedding<'_>,
+impl QueryRows for WithDescriptors<'_> {
+    fn nrows(&self) -> usize {
+        self.x.nrows()
+    }
+
+    fn rows(&self, rows: &[usize]) -> Mat<f64> {
+        let (d, k) = (self.x.nrows(), self.x.ncols());
+        let mut out = Mat::<f64>::zeros(rows.len(), k + self.scales.len());
+        gather_rows_into(out.subcols_mut(0, k), self.x, rows);
+        for (j, col) in self.descriptors.chunks_exact(d).enumerate() {
+            let dst = out
+                .col_mut(k + j)
+                .try_as_col_major_mut()
+                .expect("owned")
+                .as_slice_mut();
+            for (o, &r) in dst.iter_mut().zip(rows) {
+                *o = self.scales[j] * col[r];
+            }
+        }
+        out
+    }
+}
+
+/// The factor of every descriptor column in a last-match embedding: `λ` over the column's
+/// Euclidean norm (0 for a zero column), times `√(w_j / mean w)` with per-column weights.
+fn descriptor_scales(
     descriptors: &[f64],
+    d: usize,
     lambda: f64,
     weights: Option<&[f64]>,
-) -> Mat<f64> {
-    let (d, k) = match x {
-        Embedding::Plain(x) => (x.nrows(), x.ncols()),
-        Embedding::PulledBack(phi, c) => (phi.nrows(), c.nrows()),
-    };
-    let n = descriptors.len() / d;
+) -> Vec<f64> {
     // Checked by `validate`: one finite, non-negative weight per column, not all zero.
     let relative: Option<Vec<f64>> = weights.map(|w| {
         let mean = w.iter().sum::<f64>() / w.len() as f64;
         w.iter().map(|x| (x / mean).sqrt()).collect()
     });
-    let scales: Vec<f64> = descriptors
+    descriptors
         .chunks_exact(d)
         .enumerate()
         .map(|(j, col)| {
@@ -337,16 +360,24 @@ fn with_descriptors(
             let s = if norm > 0.0 { lambda / norm } else { 0.0 };
             relative.as_ref().map_or(s, |r| s * r[j])
         })
-        .collect();
+        .collect()
+}
+
+/// A's last-match embedding `[Φ Cᵀ | λ D̂]`: the pulled-back spectral coordinates
+/// ([`pulled_back`], `d × k`) with the descriptors appended as columns, each scaled by
+/// [`descriptor_scales`]. Written in place: one `d × (k + n)` matrix, no intermediate.
+fn with_descriptors(
+    phi: MatRef<'_, f64>,
+    c: &DMatrix<f64>,
+    descriptors: &[f64],
+    lambda: f64,
+    weights: Option<&[f64]>,
+) -> Mat<f64> {
+    let (d, k) = (phi.nrows(), c.nrows());
+    let n = descriptors.len() / d;
+    let scales = descriptor_scales(descriptors, d, lambda, weights);
     let mut out = Mat::<f64>::zeros(d, k + n);
-    match x {
-        Embedding::Plain(x) => {
-            for j in 0..k {
-                out.col_mut(j).copy_from(x.col(j));
-            }
-        }
-        Embedding::PulledBack(phi, c) => pull_back_into(out.subcols_mut(0, k), phi, c),
-    }
+    pull_back_into(out.subcols_mut(0, k), phi, c);
     for (j, col) in descriptors.chunks_exact(d).enumerate() {
         let dst = out
             .col_mut(k + j)
@@ -519,6 +550,32 @@ fn nearest_candidates(base: &Mat<f64>, query: MatRef<'_, f64>, count: usize) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// B's embedding read block by block has the entries the whole embedding had: the
+    /// spectral columns as they are, each descriptor column scaled by `λ / ‖column‖`.
+    #[test]
+    fn descriptor_rows_are_the_scaled_columns() {
+        let (d, k, n) = (37, 5, 3);
+        let x = Mat::from_fn(d, k, |i, j| ((i * 3 + j * 11) % 17) as f64 - 8.0);
+        let descriptors: Vec<f64> = (0..d * n).map(|i| ((i * 13) % 29) as f64 * 0.25).collect();
+        let query = WithDescriptors {
+            x: x.as_ref(),
+            descriptors: &descriptors,
+            scales: descriptor_scales(&descriptors, d, 500.0, None),
+        };
+        let rows = [36, 0, 17, 17];
+        let got = query.rows(&rows);
+        for (g, &r) in rows.iter().enumerate() {
+            for j in 0..k {
+                assert_eq!(got[(g, j)].to_bits(), x[(r, j)].to_bits());
+            }
+            for f in 0..n {
+                let col = &descriptors[f * d..(f + 1) * d];
+                let norm = col.iter().map(|v| v * v).sum::<f64>().sqrt();
+                assert_eq!(got[(g, k + f)].to_bits(), (500.0 / norm * col[r]).to_bits());
+            }
+        }
+    }
 
     /// The blocked parallel `Φ Cᵀ` gives every row the bits of one sequential product of the
     /// whole matrix, whatever the thread count (the last match's embedding, and so the map,
