@@ -1099,10 +1099,16 @@ mod map_guided {
                 opts.point_map = options();
                 opts
             });
+            o2.map_after_refine = true;
             o2
         };
         let (sa, sb) = (pair_shape(&a, &da), pair_shape(&b, &db));
         let out = segment_pair(sa, sb, &options).unwrap();
+        let overlapped = {
+            let mut opts = options.clone();
+            opts.map_after_refine = false;
+            segment_pair(sa, sb, &opts).unwrap()
+        };
 
         let (areas_a, areas_b) = (a.vertex_areas(), b.vertex_areas());
         let raw =
@@ -1133,6 +1139,37 @@ mod map_guided {
         .unwrap();
         assert_eq!(out.regions, by_hand);
         assert_ne!(refined, raw, "the fixture should exercise the refinement");
+
+        // By default the point map is fitted to the algorithm's regions (computed alongside
+        // the refinement) and blended into the refined ones.
+        let (labels_a, labels_b) = (raw.labels_a(), raw.labels_b());
+        let map = region_point_map(
+            &MapShape {
+                spectrum: &da.spectrum,
+                positions: a.positions(),
+                labels: &labels_a,
+                descriptors: None,
+            },
+            &MapShape {
+                spectrum: &db.spectrum,
+                positions: b.positions(),
+                labels: &labels_b,
+                descriptors: None,
+            },
+            &map_guided.point_map,
+        )
+        .unwrap();
+        let by_hand = point_map_refinement(
+            &w,
+            &refined,
+            &map,
+            &da.spectrum.vertex_areas,
+            &db.spectrum.vertex_areas,
+            Some(&smoother(&b, map_guided.smoothing_time)),
+            map_guided.map_weight,
+        )
+        .unwrap();
+        assert_eq!(overlapped.regions, by_hand);
 
         let bare = {
             let mut opts = options.clone();

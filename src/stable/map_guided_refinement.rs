@@ -84,8 +84,28 @@ pub fn map_guided_refinement(
             regions.vertices_b
         )));
     }
+    let map = region_map(regions, a, b, options)?;
+    point_map_refinement(
+        w,
+        regions,
+        &map,
+        &a.spectrum.vertex_areas,
+        &b.spectrum.vertex_areas,
+        smoother_b.filter(|_| options.smoothing_time > 0.0),
+        options.map_weight,
+    )
+}
+
+/// [`region_point_map`] from B to A fitted to `regions`' partitions (the map
+/// [`map_guided_refinement`] blends in).
+pub(crate) fn region_map(
+    regions: &StableRegions,
+    a: ShapeGeometry<'_>,
+    b: ShapeGeometry<'_>,
+    options: &MapGuidedOptions,
+) -> Result<Vec<u32>, StableError> {
     let (labels_a, labels_b) = (regions.labels_a(), regions.labels_b());
-    let map = region_point_map(
+    Ok(region_point_map(
         &MapShape {
             spectrum: a.spectrum,
             positions: a.positions,
@@ -99,16 +119,7 @@ pub fn map_guided_refinement(
             descriptors: b.descriptors,
         },
         &options.point_map,
-    )?;
-    point_map_refinement(
-        w,
-        regions,
-        &map,
-        &a.spectrum.vertex_areas,
-        &b.spectrum.vertex_areas,
-        smoother_b.filter(|_| options.smoothing_time > 0.0),
-        options.map_weight,
-    )
+    )?)
 }
 
 /// The blend of [`map_guided_refinement`] with a point map `map` from B to A given by the
