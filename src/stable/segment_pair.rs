@@ -124,9 +124,13 @@ pub struct SegmentedPair {
 
 /// Stable region correspondences between two shapes: Algorithm 2 or 3
 /// ([`stable_regions_with`](super::stable_regions_with)), then (by default) [`refine_regions`]
-/// and [`map_guided_refinement`], with heat smoothers built on the meshes at the stages'
+/// and [`map_guided_refinement`](super::map_guided_refinement), with heat smoothers built on the meshes at the stages'
 /// smoothing times. Every stage runs on one affinity, [`pair_affinity`] with
-/// [`SegmentPairOptions::feature_weights`] (equal weights by default).
+/// [`SegmentPairOptions::feature_weights`] (equal weights by default). The map step's point
+/// map is fitted to the algorithm's regions and computed alongside the refinement, then
+/// blended into the refined regions ([`point_map_refinement`]); with
+/// [`SegmentPairOptions::map_after_refine`] it is fitted to the refined regions, after them,
+/// exactly [`map_guided_refinement`](super::map_guided_refinement) of the refined regions.
 ///
 /// The two later stages are optional: one that cannot run on these shapes (a smoother that
 /// cannot be factored, a map that cannot be fitted) leaves the previous stage's regions and is
