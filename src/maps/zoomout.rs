@@ -28,7 +28,7 @@ pub struct ZoomOutOptions {
     /// descriptor column scaled to unit Euclidean norm over its shape's vertices (default 0:
     /// plain ZoomOut). About 500 makes the descriptors weigh as much as the spectral
     /// coordinates; on near-isometric pairs they pin the map where the spectral embedding
-    /// drifts (see [`MapGuidedOptions::near_isometric`](crate::stable::MapGuidedOptions)).
+    /// drifts (see [`MapGuidedOptions::near_isometric`](crate::maps::MapGuidedOptions::near_isometric)).
     pub descriptor_weight: f64,
     /// How the last point map is read from the embeddings (default
     /// [`FinalMatch::default`]: a near-bijective assignment).

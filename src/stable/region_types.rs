@@ -33,7 +33,9 @@ pub enum TSearch {
     Bisect,
 }
 
-/// Options of [`stable_regions`], [`stable_pairs_fixed`] and [`stable_pairs_auto`].
+/// Options of [`stable_regions`](super::stable_regions),
+/// [`stable_pairs_fixed`](super::stable_pairs_fixed) and
+/// [`stable_pairs_auto`](super::stable_pairs_auto).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[non_exhaustive]
 pub struct StableRegionsOptions {

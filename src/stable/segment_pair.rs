@@ -1,6 +1,6 @@
 //! [`segment_pair`]: the whole pair stage in one call (Algorithm 2 or 3 →
-//! [`refine_regions`] → [`map_guided_refinement`](super::map_guided_refinement), all on one affinity), as `coseg pair` runs
-//! it.
+//! [`refine_regions`] → [`map_guided_refinement`](super::map_guided_refinement), all on one
+//! affinity), as `coseg pair` runs it.
 
 use super::map_guided_refinement::region_map;
 use super::stable_regions::{pair_affinity, stable_regions_with};
@@ -124,8 +124,8 @@ pub struct SegmentedPair {
 
 /// Stable region correspondences between two shapes: Algorithm 2 or 3
 /// ([`stable_regions_with`](super::stable_regions_with)), then (by default) [`refine_regions`]
-/// and [`map_guided_refinement`](super::map_guided_refinement), with heat smoothers built on the meshes at the stages'
-/// smoothing times. Every stage runs on one affinity, [`pair_affinity`] with
+/// and [`map_guided_refinement`](super::map_guided_refinement), with heat smoothers built on
+/// the meshes at the stages' smoothing times. Every stage runs on one affinity, [`pair_affinity`] with
 /// [`SegmentPairOptions::feature_weights`] (equal weights by default). The map step's point
 /// map is fitted to the algorithm's regions and computed alongside the refinement, then
 /// blended into the refined regions ([`point_map_refinement`]); with
@@ -368,7 +368,7 @@ fn fit_map_sizes(options: &MapGuidedOptions, available: usize) -> MapGuidedOptio
 pub enum PairStage {
     /// [`refine_regions`].
     Refine,
-    /// [`map_guided_refinement`].
+    /// [`map_guided_refinement`](super::map_guided_refinement).
     MapGuided,
 }
 
