@@ -602,3 +602,44 @@ fn warm_runs_write_the_cold_runs_files_byte_for_byte() {
     let (uncached, _) = features("3", "features-uncached", None);
     same(&cold, &uncached, "features cold / no cache");
 }
+
+/// Regression: the band-affinity kernel read an undocumented `KERNEL` variable on every
+/// operator application, smoothed its tables with the numbers it held and panicked on
+/// anything else. The environment must not reach the method: `coseg pair` with a stray
+/// `KERNEL` (malformed, then well-formed) succeeds and writes what it writes without one.
+#[test]
+fn regression_kernel_environment_variable_is_ignored() {
+    let dir = tempfile::tempdir().unwrap();
+    shapes(dir.path(), 2, 2);
+    let regions = |kernel: Option<&str>| {
+        let out = dir
+            .path()
+            .join(format!("pair-{}", kernel.unwrap_or("none")));
+        let mut cmd = Command::new(env!("CARGO_BIN_EXE_coseg"));
+        cmd.args([
+            "-q",
+            "pair",
+            s(&dir.path().join("s0.obj")),
+            s(&dir.path().join("s1.off")),
+            "-o",
+            s(&out),
+            "--no-pictures",
+            "--eigenpairs",
+            "20",
+            "--bands",
+            "6",
+            "--pairs",
+            "4",
+        ]);
+        match kernel {
+            Some(k) => cmd.env("KERNEL", k),
+            None => cmd.env_remove("KERNEL"),
+        };
+        let run = cmd.output().expect("run coseg");
+        assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+        std::fs::read(out.join("s0.regions.txt")).unwrap()
+    };
+    let clean = regions(None);
+    assert_eq!(clean, regions(Some("not,numbers")));
+    assert_eq!(clean, regions(Some("1,3")));
+}

@@ -574,21 +574,6 @@ impl<'a> BandAffinity<'a> {
             if self.identity {
                 ws.table_u[..nk].copy_from_slice(&ws.hist_u[..nk]);
             }
-            if let Ok(kv) = std::env::var("KERNEL") {
-                let v: Vec<u32> = kv.split(',').map(|x| x.parse().unwrap()).collect();
-                let (c, n) = (v[0], v[1]);
-                let nf = dst.features;
-                let mut tmp = vec![0u32; k];
-                for f in 0..nf {
-                    let t = &mut ws.table_u[f * k..(f + 1) * k];
-                    for j in 0..k {
-                        let l = t[j.saturating_sub(1)];
-                        let r = t[(j + 1).min(k - 1)];
-                        tmp[j] = c * t[j] + n * (l + r);
-                    }
-                    t.copy_from_slice(&tmp);
-                }
-            }
             let table: &[u32] = &ws.table_u[..nk];
             match &self.pair_labels {
                 Some((pa, pb)) => {
