@@ -1,7 +1,9 @@
 //! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
 //! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
 
-use super::nearest_rows::{QueryRows, gather_rows, gather_rows_into, nearest_candidates_owned};
+use super::nearest_rows::{
+    OwnedBase, QueryRows, gather_rows, gather_rows_into, in_single, nearest_candidates_owned,
+};
 use super::{AuctionOptions, CandidateLists, auction_assignment};
 use crate::spectral::{SpectralError, Spectrum};
 use faer::linalg::matmul::matmul;
@@ -270,7 +272,8 @@ pub(crate) fn zoomout_from(
     match (a.descriptors, b.descriptors) {
         (Some(da), Some(db)) if lambda > 0.0 => {
             let w = options.descriptor_weights.as_deref();
-            let base = with_descriptors(phi_a, &c, da, lambda, w);
+            let scales_a = descriptor_scales(da, phi_a.nrows(), lambda, w);
+            let base = last_match_base(phi_a, &c, Some((da, &scales_a)));
             let query = WithDescriptors {
                 x: phi_b.subcols(0, k),
                 descriptors: db,
@@ -279,7 +282,7 @@ pub(crate) fn zoomout_from(
             final_point_map(base, &query, &options.final_match)
         }
         _ => final_point_map(
-            pulled_back(phi_a, &c),
+            last_match_base(phi_a, &c, None),
             &phi_b.subcols(0, k),
             &options.final_match,
         ),
@@ -288,7 +291,7 @@ pub(crate) fn zoomout_from(
 
 /// The last point map: rows of `query` (B) to rows of `base` (A).
 fn final_point_map<Q: QueryRows + ?Sized>(
-    base: Mat<f64>,
+    base: OwnedBase,
     query: &Q,
     final_match: &FinalMatch,
 ) -> Result<Vec<u32>, SpectralError> {
@@ -364,31 +367,74 @@ fn descriptor_scales(
 }
 
 /// A's last-match embedding `[Φ Cᵀ | λ D̂]`: the pulled-back spectral coordinates
-/// ([`pulled_back`], `d × k`) with the descriptors appended as columns, each scaled by
-/// [`descriptor_scales`]. Written in place: one `d × (k + n)` matrix, no intermediate.
-fn with_descriptors(
+/// ([`pulled_back`], `d × k`) with the descriptors (`d × n`, column-major) appended as columns,
+/// each scaled by its factor ([`descriptor_scales`]), or `Φ Cᵀ` alone. Written in place,
+/// one `d × (k + n)` matrix: in double precision for a base the brute force searches, built
+/// directly in single precision (products in double, then rounded, a block of rows at a
+/// time) for one the clustered search will compare in single precision
+/// ([`nearest_rows::in_single`](super::nearest_rows::in_single)), so that the double matrix
+/// is never held whole.
+fn last_match_base(
     phi: MatRef<'_, f64>,
     c: &DMatrix<f64>,
-    descriptors: &[f64],
-    lambda: f64,
-    weights: Option<&[f64]>,
-) -> Mat<f64> {
+    descriptors: Option<(&[f64], &[f64])>,
+) -> OwnedBase {
     let (d, k) = (phi.nrows(), c.nrows());
-    let n = descriptors.len() / d;
-    let scales = descriptor_scales(descriptors, d, lambda, weights);
-    let mut out = Mat::<f64>::zeros(d, k + n);
-    pull_back_into(out.subcols_mut(0, k), phi, c);
-    for (j, col) in descriptors.chunks_exact(d).enumerate() {
-        let dst = out
-            .col_mut(k + j)
-            .try_as_col_major_mut()
-            .expect("owned")
-            .as_slice_mut();
-        for (o, &v) in dst.iter_mut().zip(col) {
-            *o = scales[j] * v;
+    let n = descriptors.map_or(0, |(_, scales)| scales.len());
+    if !in_single(d) {
+        let mut out = Mat::<f64>::zeros(d, k + n);
+        pull_back_into(out.subcols_mut(0, k), phi, c);
+        if let Some((descriptors, scales)) = descriptors {
+            for (j, col) in descriptors.chunks_exact(d).enumerate() {
+                let dst = out
+                    .col_mut(k + j)
+                    .try_as_col_major_mut()
+                    .expect("owned")
+                    .as_slice_mut();
+                for (o, &v) in dst.iter_mut().zip(col) {
+                    *o = scales[j] * v;
+                }
+            }
+        }
+        return OwnedBase::Double(out);
+    }
+    use rayon::prelude::*;
+    let mut out = Mat::<f32>::zeros(d, k + n);
+    let ct = Mat::from_fn(c.ncols(), k, |i, j| c[(j, i)]);
+    let phi = phi.subcols(0, c.ncols());
+    out.as_mut()
+        .subcols_mut(0, k)
+        .par_row_chunks_mut(PULL_BACK_ROWS)
+        .zip(phi.par_row_chunks(PULL_BACK_ROWS))
+        .for_each(|(mut out, phi)| {
+            let mut wide = Mat::<f64>::zeros(phi.nrows(), k);
+            matmul(
+                wide.as_mut(),
+                Accum::Replace,
+                phi,
+                ct.as_ref(),
+                1.0,
+                Par::Seq,
+            );
+            for j in 0..k {
+                for (o, &x) in out.as_mut().col_mut(j).iter_mut().zip(wide.col(j).iter()) {
+                    *o = x as f32;
+                }
+            }
+        });
+    if let Some((descriptors, scales)) = descriptors {
+        for (j, col) in descriptors.chunks_exact(d).enumerate() {
+            let dst = out
+                .col_mut(k + j)
+                .try_as_col_major_mut()
+                .expect("owned")
+                .as_slice_mut();
+            for (o, &v) in dst.iter_mut().zip(col) {
+                *o = (scales[j] * v) as f32;
+            }
         }
     }
-    out
+    OwnedBase::Single(out)
 }
 
 /// The first `k` eigenvectors as a `d × k` view.
@@ -660,6 +706,45 @@ mod tests {
                 assert_eq!(got[(g, k + f)].to_bits(), (500.0 / norm * col[r]).to_bits());
             }
         }
+    }
+
+    /// A base large enough for the clustered search is built in single precision, each entry
+    /// the double-precision one rounded (products blocked as in [`pull_back_into`], then
+    /// rounded), whatever the thread count; a smaller one stays in double precision.
+    #[test]
+    fn last_match_base_is_the_double_embedding_rounded() {
+        let (d, k, n) = (2 * PULL_BACK_ROWS + 517, 9, 2);
+        assert!(in_single(d) && !in_single(d / 4));
+        let phi = Mat::from_fn(d, k + 3, |i, j| {
+            ((i * 7 + j * 13) % 101) as f64 / 37.0 - 1.3
+        });
+        let c = DMatrix::from_fn(k, k, |i, j| ((i * 5 + j * 3) % 11) as f64 / 7.0 - 0.6);
+        let descriptors: Vec<f64> = (0..d * n).map(|i| ((i * 13) % 29) as f64 * 0.25).collect();
+        let scales = descriptor_scales(&descriptors, d, 500.0, None);
+        let wide = pulled_back(phi.as_ref(), &c);
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let base =
+                pool.install(|| last_match_base(phi.as_ref(), &c, Some((&descriptors, &scales))));
+            let OwnedBase::Single(base) = base else {
+                panic!("single precision expected")
+            };
+            assert_eq!((base.nrows(), base.ncols()), (d, k + n));
+            for i in (0..d).step_by(97) {
+                for j in 0..k {
+                    assert_eq!(base[(i, j)].to_bits(), (wide[(i, j)] as f32).to_bits());
+                }
+                for f in 0..n {
+                    let v = (scales[f] * descriptors[f * d + i]) as f32;
+                    assert_eq!(base[(i, k + f)].to_bits(), v.to_bits());
+                }
+            }
+        }
+        let small = last_match_base(phi.subrows(0, d / 4), &c, None);
+        assert!(matches!(small, OwnedBase::Double(_)));
     }
 
     /// The blocked parallel `Φ Cᵀ` gives every row the bits of one sequential product of the
