@@ -50,6 +50,16 @@ fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
 
+/// `coseg -q pair` between the first two of [`shapes`] in `dir`, writing to `out`, with no
+/// pictures and 20 eigenpairs: the start of a quick pair run's arguments.
+fn small_pair(dir: &Path, out: &Path) -> Vec<String> {
+    let mut args: Vec<String> = ["-q", "pair"].map(String::from).to_vec();
+    args.push(s(&dir.join("s0.obj")).to_string());
+    args.push(s(&dir.join("s1.off")).to_string());
+    args.extend(["-o", s(out), "--no-pictures", "--eigenpairs", "20"].map(String::from));
+    args
+}
+
 fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
     let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
         .unwrap()
@@ -297,16 +307,9 @@ fn pair_weighs_the_feature_families() {
     shapes(dir.path(), 2, 2);
     let regions = |weights: &str| {
         let out = dir.path().join(format!("pair-{weights}"));
-        let run = coseg(&[
-            "-q",
-            "pair",
-            s(&dir.path().join("s0.obj")),
-            s(&dir.path().join("s1.off")),
-            "-o",
-            s(&out),
-            "--no-pictures",
-            "--eigenpairs",
-            "20",
+        let prefix = small_pair(dir.path(), &out);
+        let mut args: Vec<&str> = prefix.iter().map(String::as_str).collect();
+        args.extend([
             "--hks",
             "6",
             "--wks",
@@ -326,6 +329,7 @@ fn pair_weighs_the_feature_families() {
             "--family-weights",
             weights,
         ]);
+        let run = coseg(&args);
         assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
         std::fs::read(out.join("s0.regions.txt")).unwrap()
     };
@@ -616,21 +620,8 @@ fn regression_kernel_environment_variable_is_ignored() {
             .path()
             .join(format!("pair-{}", kernel.unwrap_or("none")));
         let mut cmd = Command::new(env!("CARGO_BIN_EXE_coseg"));
-        cmd.args([
-            "-q",
-            "pair",
-            s(&dir.path().join("s0.obj")),
-            s(&dir.path().join("s1.off")),
-            "-o",
-            s(&out),
-            "--no-pictures",
-            "--eigenpairs",
-            "20",
-            "--bands",
-            "6",
-            "--pairs",
-            "4",
-        ]);
+        cmd.args(small_pair(dir.path(), &out))
+            .args(["--bands", "6", "--pairs", "4"]);
         match kernel {
             Some(k) => cmd.env("KERNEL", k),
             None => cmd.env_remove("KERNEL"),

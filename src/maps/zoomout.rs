@@ -384,18 +384,7 @@ fn last_match_base(
     if !in_single(d) {
         let mut out = Mat::<f64>::zeros(d, k + n);
         pull_back_into(out.subcols_mut(0, k), phi, c);
-        if let Some((descriptors, scales)) = descriptors {
-            for (j, col) in descriptors.chunks_exact(d).enumerate() {
-                let dst = out
-                    .col_mut(k + j)
-                    .try_as_col_major_mut()
-                    .expect("owned")
-                    .as_slice_mut();
-                for (o, &v) in dst.iter_mut().zip(col) {
-                    *o = scales[j] * v;
-                }
-            }
-        }
+        append_descriptors(&mut out, k, descriptors, |x| x);
         return OwnedBase::Double(out);
     }
     use rayon::prelude::*;
@@ -422,19 +411,31 @@ fn last_match_base(
                 }
             }
         });
-    if let Some((descriptors, scales)) = descriptors {
-        for (j, col) in descriptors.chunks_exact(d).enumerate() {
-            let dst = out
-                .col_mut(k + j)
-                .try_as_col_major_mut()
-                .expect("owned")
-                .as_slice_mut();
-            for (o, &v) in dst.iter_mut().zip(col) {
-                *o = (scales[j] * v) as f32;
-            }
+    append_descriptors(&mut out, k, descriptors, |x| x as f32);
+    OwnedBase::Single(out)
+}
+
+/// Writes column `j` of the descriptors (`d × n`, column-major), times `scales[j]` and
+/// converted by `narrow`, into column `k + j` of `out` (`d` rows).
+fn append_descriptors<T: Copy>(
+    out: &mut Mat<T>,
+    k: usize,
+    descriptors: Option<(&[f64], &[f64])>,
+    narrow: impl Fn(f64) -> T,
+) {
+    let Some((descriptors, scales)) = descriptors else {
+        return;
+    };
+    for (j, col) in descriptors.chunks_exact(out.nrows()).enumerate() {
+        let dst = out
+            .col_mut(k + j)
+            .try_as_col_major_mut()
+            .expect("owned")
+            .as_slice_mut();
+        for (o, &v) in dst.iter_mut().zip(col) {
+            *o = narrow(scales[j] * v);
         }
     }
-    OwnedBase::Single(out)
 }
 
 /// The first `k` eigenvectors as a `d × k` view.
