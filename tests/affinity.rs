@@ -224,9 +224,23 @@ fn rejects_bad_input() {
     let a = random_table(10, 3, 4, 1);
     let mut b = random_table(12, 3, 4, 2);
     b.labels[5] = 4;
+    b.labels[30] = 255;
+    // The first offending entry is named (vertex 5 / 3 features = 1), from either side.
     assert!(matches!(
         BandAffinity::new(&a, &b),
-        Err(AffinityError::LabelOutOfRange { .. })
+        Err(AffinityError::LabelOutOfRange {
+            vertex: 1,
+            label: 4,
+            ..
+        })
+    ));
+    assert!(matches!(
+        BandAffinity::new(&b, &a),
+        Err(AffinityError::LabelOutOfRange {
+            vertex: 1,
+            label: 4,
+            ..
+        })
     ));
     let c = random_table(12, 3, 5, 2);
     assert!(matches!(
