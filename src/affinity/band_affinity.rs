@@ -89,8 +89,11 @@ pub struct BandAffinity<'a> {
     /// `K ≤ PAIR_MAX_BANDS`: the integer gather then reads one `u16` and one table entry per two
     /// features. Each side is built on its first gather, since many operators (a propagation's
     /// votes) only ever transport one way.
-    pair_labels: Option<(OnceLock<Vec<u16>>, OnceLock<Vec<u16>>)>,
+    pair_labels: Option<(PairLabels, PairLabels)>,
 }
+
+/// One side's pair labels, built on first use.
+type PairLabels = OnceLock<Vec<u16>>;
 
 /// Largest `K` for which the paired gather is used (its table has `ceil(N/2) K²` entries).
 const PAIR_MAX_BANDS: usize = 32;
