@@ -121,31 +121,22 @@ fn clustered<T: Element, Q: QueryRows + ?Sized>(base: MatRef<'_, T>, query: &Q) 
         && query.is_finite()
 }
 
-/// The element types a clustered search holds its base in.
+/// The element types a base is held in (double for the brute force, single for the
+/// clustered search).
 pub(crate) trait Element: faer::traits::ComplexField + Copy + Send + Sync + 'static {
     /// The value in double precision.
     fn widen(self) -> f64;
-    /// The rows `rows` of `query` in this precision.
-    fn query_rows<Q: QueryRows + ?Sized>(query: &Q, rows: &[usize]) -> Mat<Self>;
 }
 
 impl Element for f64 {
     fn widen(self) -> f64 {
         self
     }
-
-    fn query_rows<Q: QueryRows + ?Sized>(query: &Q, rows: &[usize]) -> Mat<f64> {
-        query.rows(rows)
-    }
 }
 
 impl Element for f32 {
     fn widen(self) -> f64 {
         f64::from(self)
-    }
-
-    fn query_rows<Q: QueryRows + ?Sized>(query: &Q, rows: &[usize]) -> Mat<f32> {
-        query.single_rows(rows)
     }
 }
 
@@ -661,7 +652,7 @@ fn search_group<Q: QueryRows + ?Sized>(
     count: usize,
 ) -> Vec<Neighbours> {
     let rows: Vec<usize> = group.iter().map(|&(_, q)| q as usize).collect();
-    let rows = f32::query_rows(query, &rows);
+    let rows = query.single_rows(&rows);
     let q_norms = row_norms(rows.as_ref());
     let clusters = c.count();
     let mut needed = vec![false; clusters];
