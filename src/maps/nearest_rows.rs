@@ -221,11 +221,7 @@ pub(crate) fn gather_rows<T: Element>(m: MatRef<'_, T>, rows: &[usize]) -> Mat<T
 }
 
 /// [`gather_rows`] into `out` (`rows.len() × m.ncols()`, column-major).
-pub(crate) fn gather_rows_into<T: Element>(
-    mut out: MatMut<'_, T>,
-    m: MatRef<'_, T>,
-    rows: &[usize],
-) {
+fn gather_rows_into<T: Element>(mut out: MatMut<'_, T>, m: MatRef<'_, T>, rows: &[usize]) {
     for j in 0..m.ncols() {
         let dst = out
             .as_mut()

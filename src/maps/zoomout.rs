@@ -1,9 +1,7 @@
 //! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
 //! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
 
-use super::nearest_rows::{
-    OwnedBase, QueryRows, gather_rows, gather_rows_into, in_single, nearest_candidates_owned,
-};
+use super::nearest_rows::{OwnedBase, QueryRows, gather_rows, in_single, nearest_candidates_owned};
 use super::{AuctionOptions, CandidateLists, auction_assignment};
 use crate::spectral::{SpectralError, Spectrum};
 use faer::linalg::matmul::matmul;
@@ -325,42 +323,43 @@ impl QueryRows for WithDescriptors<'_> {
     }
 
     fn rows(&self, rows: &[usize]) -> Mat<f64> {
-        let (d, k) = (self.x.nrows(), self.x.ncols());
-        let mut out = Mat::<f64>::zeros(rows.len(), k + self.scales.len());
-        gather_rows_into(out.subcols_mut(0, k), self.x, rows);
-        for (j, col) in self.descriptors.chunks_exact(d).enumerate() {
-            let dst = out
-                .col_mut(k + j)
-                .try_as_col_major_mut()
-                .expect("owned")
-                .as_slice_mut();
-            for (o, &r) in dst.iter_mut().zip(rows) {
-                *o = self.scales[j] * col[r];
-            }
-        }
-        out
+        self.rows_as(rows, |x| x)
     }
 
     /// The same rows rounded, written directly: the clustered search reads every row of B
     /// this way, twice (probing, then its group), and the double-precision block in between
     /// was a fortieth of `coseg pair`'s CPU on victoria0 × david0 (`perf`).
     fn single_rows(&self, rows: &[usize]) -> Mat<f32> {
+        self.rows_as(rows, |x| x as f32)
+    }
+}
+
+impl WithDescriptors<'_> {
+    /// The rows `rows` of `[x | λ D̂]`, each entry computed in double precision and converted
+    /// by `narrow`.
+    fn rows_as<T: faer::traits::ComplexField + Copy>(
+        &self,
+        rows: &[usize],
+        narrow: impl Fn(f64) -> T,
+    ) -> Mat<T> {
         let (d, k) = (self.x.nrows(), self.x.ncols());
-        let mut out = Mat::<f32>::zeros(rows.len(), k + self.scales.len());
-        for j in 0..k {
-            let src = self.x.col(j);
-            for (o, &r) in out.col_mut(j).iter_mut().zip(rows) {
-                *o = src[r] as f32;
-            }
-        }
-        for (j, col) in self.descriptors.chunks_exact(d).enumerate() {
+        let mut out = Mat::<T>::zeros(rows.len(), k + self.scales.len());
+        for j in 0..out.ncols() {
             let dst = out
-                .col_mut(k + j)
+                .col_mut(j)
                 .try_as_col_major_mut()
                 .expect("owned")
                 .as_slice_mut();
-            for (o, &r) in dst.iter_mut().zip(rows) {
-                *o = (self.scales[j] * col[r]) as f32;
+            if j < k {
+                let src = self.x.col(j);
+                for (o, &r) in dst.iter_mut().zip(rows) {
+                    *o = narrow(src[r]);
+                }
+            } else {
+                let (col, scale) = (&self.descriptors[(j - k) * d..][..d], self.scales[j - k]);
+                for (o, &r) in dst.iter_mut().zip(rows) {
+                    *o = narrow(scale * col[r]);
+                }
             }
         }
         out
