@@ -56,10 +56,19 @@ pub fn nearest_candidates(
     query: MatRef<'_, f64>,
     count: usize,
 ) -> CandidateLists {
-    if clustered(base, &query) {
-        clustered_candidates(single(base), &query, count)
+    double_candidates(base, &query, count)
+}
+
+/// [`nearest_candidates`] for any query rows.
+fn double_candidates<Q: QueryRows + ?Sized>(
+    base: MatRef<'_, f64>,
+    query: &Q,
+    count: usize,
+) -> CandidateLists {
+    if clustered(&base, query) {
+        clustered_candidates(single(base), query, count)
     } else {
-        brute_force_candidates(base, &query, count)
+        brute_force_candidates(base, query, count)
     }
 }
 
@@ -97,11 +106,8 @@ pub(crate) fn nearest_candidates_owned<Q: QueryRows + ?Sized>(
     count: usize,
 ) -> CandidateLists {
     match base {
-        OwnedBase::Double(base) if clustered(base.as_ref(), query) => {
-            clustered_candidates(single(base.as_ref()), query, count)
-        }
-        OwnedBase::Double(base) => brute_force_candidates(base.as_ref(), query, count),
-        OwnedBase::Single(base) if clustered(base.as_ref(), query) => {
+        OwnedBase::Double(base) => double_candidates(base.as_ref(), query, count),
+        OwnedBase::Single(base) if clustered(&base.as_ref(), query) => {
             clustered_candidates(base, query, count)
         }
         OwnedBase::Single(base) => {
@@ -114,11 +120,8 @@ pub(crate) fn nearest_candidates_owned<Q: QueryRows + ?Sized>(
 
 /// Whether [`nearest_candidates`] takes the clustered search: a large base, and no NaN
 /// (whose ranking the centre distances cannot follow).
-fn clustered<T: Element, Q: QueryRows + ?Sized>(base: MatRef<'_, T>, query: &Q) -> bool {
-    base.nrows() >= PRUNE_FROM
-        && query.nrows() > 0
-        && (0..base.ncols()).all(|j| base.col(j).iter().all(|x| x.widen().is_finite()))
-        && query.is_finite()
+fn clustered<B: QueryRows + ?Sized, Q: QueryRows + ?Sized>(base: &B, query: &Q) -> bool {
+    base.nrows() >= PRUNE_FROM && query.nrows() > 0 && base.is_finite() && query.is_finite()
 }
 
 /// The element types a base is held in (double for the brute force, single for the

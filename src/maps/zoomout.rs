@@ -411,30 +411,16 @@ fn last_match_base(
         append_descriptors(&mut out, k, descriptors, |x| x);
         return OwnedBase::Double(out);
     }
-    use rayon::prelude::*;
     let mut out = Mat::<f32>::zeros(d, k + n);
-    let ct = Mat::from_fn(c.ncols(), k, |i, j| c[(j, i)]);
-    let phi = phi.subcols(0, c.ncols());
-    out.as_mut()
-        .subcols_mut(0, k)
-        .par_row_chunks_mut(PULL_BACK_ROWS)
-        .zip(phi.par_row_chunks(PULL_BACK_ROWS))
-        .for_each(|(mut out, phi)| {
-            let mut wide = Mat::<f64>::zeros(phi.nrows(), k);
-            matmul(
-                wide.as_mut(),
-                Accum::Replace,
-                phi,
-                ct.as_ref(),
-                1.0,
-                Par::Seq,
-            );
-            for j in 0..k {
-                for (o, &x) in out.as_mut().col_mut(j).iter_mut().zip(wide.col(j).iter()) {
-                    *o = x as f32;
-                }
+    pull_back_blocks(out.subcols_mut(0, k), phi, c, |mut out, phi, ct| {
+        let mut wide = Mat::<f64>::zeros(phi.nrows(), k);
+        matmul(wide.as_mut(), Accum::Replace, phi, ct, 1.0, Par::Seq);
+        for j in 0..k {
+            for (o, &x) in out.as_mut().col_mut(j).iter_mut().zip(wide.col(j).iter()) {
+                *o = x as f32;
             }
-        });
+        }
+    });
     append_descriptors(&mut out, k, descriptors, |x| x as f32);
     OwnedBase::Single(out)
 }
@@ -482,13 +468,27 @@ const PULL_BACK_ROWS: usize = 4096;
 
 /// `out = Φ Cᵀ` (`out` is `Φ.nrows() × C.nrows()`), in parallel over fixed blocks of rows.
 fn pull_back_into(out: MatMut<'_, f64>, phi: MatRef<'_, f64>, c: &DMatrix<f64>) {
+    pull_back_blocks(out, phi, c, |out, phi, ct| {
+        matmul(out, Accum::Replace, phi, ct, 1.0, Par::Seq)
+    });
+}
+
+/// Calls `write(out rows, Φ rows, Cᵀ)` on every block of [`PULL_BACK_ROWS`] rows of `out`
+/// (`Φ.nrows() × C.nrows()`) and the same rows of `Φ`'s first `C.ncols()` columns, in
+/// parallel: the one blocking of `Φ Cᵀ`, whatever precision `out` is written in.
+fn pull_back_blocks<T: faer::traits::ComplexField>(
+    out: MatMut<'_, T>,
+    phi: MatRef<'_, f64>,
+    c: &DMatrix<f64>,
+    write: impl Fn(MatMut<'_, T>, MatRef<'_, f64>, MatRef<'_, f64>) + Sync,
+) {
     use rayon::prelude::*;
     let k = c.ncols();
     let ct = Mat::from_fn(k, c.nrows(), |i, j| c[(j, i)]);
     let phi = phi.subcols(0, k);
     out.par_row_chunks_mut(PULL_BACK_ROWS)
         .zip(phi.par_row_chunks(PULL_BACK_ROWS))
-        .for_each(|(out, phi)| matmul(out, Accum::Replace, phi, ct.as_ref(), 1.0, Par::Seq));
+        .for_each(|(out, phi)| write(out, phi, ct.as_ref()));
 }
 
 /// Least-squares functional map of a point map: `C = argmin ‖Φ_B C − Φ_A[T]‖` (rows of `phi_b`
@@ -651,8 +651,6 @@ fn nearest_candidates(base: &Mat<f64>, query: MatRef<'_, f64>, count: usize) -> 
 mod tests {
     use super::*;
 
-    /// B's embedding read block by block has the entries the whole embedding had: the
-    /// spectral columns as they are, each descriptor column scaled by `λ / ‖column‖`.
     /// The vectorised farthest-point sampling chooses what the one-pass scan chose, ties
     /// (repeated points) and a NaN coordinate included.
     #[test]
@@ -709,6 +707,9 @@ mod tests {
         }
     }
 
+    /// B's embedding read block by block has the entries the whole embedding had: the
+    /// spectral columns as they are, each descriptor column scaled by `λ / ‖column‖`; in
+    /// single precision, those entries rounded.
     #[test]
     fn descriptor_rows_are_the_scaled_columns() {
         let (d, k, n) = (37, 5, 3);
