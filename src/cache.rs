@@ -20,7 +20,7 @@
 //! [`write_entry`] writes atomically (temporary file in the same directory, then rename), so a
 //! crash never leaves a half-written entry under a valid name.
 //!
-//! # What the entries hold (format version 4)
+//! # What the entries hold (format version 5)
 //! Per shape, at the default options (200 eigenpairs, 300 features, 20 bands), `d` vertices:
 //!
 //! | file | value | content | bytes (≈) |
@@ -33,7 +33,8 @@
 //! ([`crate::pipeline::StoredShape::into_shape_data`]), about 0.07 s for 10k vertices, and
 //! gets the same bits because the pipeline rounds the eigenvectors to `f32` before anything
 //! uses them. Format 3 stored everything in f64 (43 MB for 10k vertices, 227 MB for 52k);
-//! such entries read as stale and are recomputed. Measurements and the reasoning:
+//! format 4 had the layout of 5 but cut the normal columns into rank bands (5: fixed-range
+//! bands, [`crate::bands::fixed_range_bands`]); such entries read as stale and are recomputed. Measurements and the reasoning:
 //! `docs/PERFORMANCE.md`, "Compact cache".
 
 use crate::mesh::{TriMesh, write_atomic};
@@ -44,7 +45,7 @@ use std::path::{Path, PathBuf};
 
 /// Version of the cache file format and of the computations it stores. Bump it whenever the
 /// layout or any algorithm's output changes: older files then read as stale and are recomputed.
-pub const FORMAT_VERSION: u32 = 4;
+pub const FORMAT_VERSION: u32 = 5;
 
 const HEADER_LEN: usize = 8 + 4 + 32 + 8 + 32;
 /// File extension of full entries ([`EntryKind::Full`]).

@@ -6,8 +6,12 @@ mod common;
 use common::features::{blob, permutation};
 use coseg::bands::{
     BandOptions, BandTable, BandWeighting, area_weighted_bands, band_table, equal_count_bands,
+    fixed_range_bands,
 };
-use coseg::features::{DescriptorOptions, descriptors};
+use coseg::features::{
+    DescriptorOptions, Descriptors, ExtrinsicOptions, descriptors, extrinsic_features,
+};
+use coseg::mesh::TriMesh;
 use coseg::spectral::dense_spectrum;
 use proptest::prelude::*;
 use proptest::test_runner::{Config, RngAlgorithm, TestRng, TestRunner};
@@ -246,4 +250,165 @@ fn large_skewed_and_tied_features_match_the_oracle() {
         let t = equal_count_bands(&values, n, d, k).unwrap();
         assert_eq!(t.labels, oracle(&values, n, d, k), "K = {k}");
     }
+}
+
+/// Exact oracle: each value is drawn inside a known band, away from its edges, or exactly on
+/// an edge (which belongs to the band above it), or beyond the range (the end bands).
+#[test]
+fn fixed_range_bands_put_every_value_in_its_interval() {
+    let strategy = (1usize..40, -5.0f64..5.0, 0.01f64..10.0).prop_flat_map(|(k, lo, width)| {
+        let value = (0..k, 0.001f64..0.999, 0u8..4).prop_map(move |(b, frac, kind)| {
+            let step = width / k as f64;
+            match kind {
+                0 => (lo - 1.0 - frac, 0),
+                1 => (lo + width + frac, k - 1),
+                _ => (lo + (b as f64 + frac) * step, b),
+            }
+        });
+        (
+            Just(k),
+            Just([lo, lo + width]),
+            proptest::collection::vec(value, 1..60),
+        )
+    });
+    runner()
+        .run(&strategy, |(k, range, pairs)| {
+            let (values, want): (Vec<f64>, Vec<usize>) = pairs.into_iter().unzip();
+            let got = fixed_range_bands(&values, range, k).unwrap();
+            let got: Vec<usize> = got.into_iter().map(usize::from).collect();
+            prop_assert_eq!(got, want);
+            Ok(())
+        })
+        .unwrap();
+    // Edges belong to the band above; the ends and infinities clamp.
+    let edges = [
+        0.0,
+        0.25,
+        0.5,
+        0.75,
+        1.0,
+        -1.0,
+        f64::INFINITY,
+        f64::NEG_INFINITY,
+    ];
+    assert_eq!(
+        fixed_range_bands(&edges, [0.0, 1.0], 4).unwrap(),
+        vec![0, 1, 2, 3, 3, 0, 3, 0]
+    );
+    assert_eq!(
+        fixed_range_bands(&[0.3, 0.7], [0.0, 1.0], 256).unwrap(),
+        vec![76, 179]
+    );
+}
+
+#[test]
+fn fixed_range_bands_refuse_bad_input() {
+    assert!(fixed_range_bands(&[0.5], [0.0, 1.0], 0).is_err());
+    assert!(fixed_range_bands(&[0.5], [0.0, 1.0], 257).is_err());
+    assert!(fixed_range_bands(&[0.5], [1.0, 1.0], 4).is_err());
+    assert!(fixed_range_bands(&[0.5], [1.0, 0.0], 4).is_err());
+    assert!(fixed_range_bands(&[0.5], [0.0, f64::INFINITY], 4).is_err());
+    assert!(fixed_range_bands(&[0.5], [f64::NAN, 1.0], 4).is_err());
+    let e = fixed_range_bands(&[0.5, f64::NAN], [0.0, 1.0], 4).unwrap_err();
+    assert!(
+        matches!(e, coseg::bands::BandError::NaN { vertex: 1, .. }),
+        "{e}"
+    );
+    assert_eq!(
+        fixed_range_bands(&[], [0.0, 1.0], 4).unwrap(),
+        Vec::<u8>::new()
+    );
+}
+
+/// Spectral descriptors (3 per kind) of `mesh` followed by the extrinsic family with `up = z`,
+/// 3 height directions and `normals` normal columns.
+fn with_extrinsic(mesh: &TriMesh, normals: usize) -> Descriptors {
+    let s = dense_spectrum(mesh, 12).unwrap();
+    let mut opts = DescriptorOptions::default();
+    (opts.hks_count, opts.wks_count, opts.curvature_count) = (3, 3, 3);
+    let mut d = descriptors(mesh, &s, &opts).unwrap();
+    let mut e = ExtrinsicOptions::default();
+    e.alignment = coseg::features::Alignment::Up("z".parse().unwrap());
+    (e.directions, e.normal_directions) = (3, normals);
+    let c = extrinsic_features(mesh, &e).unwrap();
+    let n = c.len();
+    d.append(c, [n, 0, 0]).unwrap();
+    d
+}
+
+#[test]
+fn band_table_cuts_the_normal_columns_by_value_and_the_rest_by_rank() {
+    let mesh = blob(2);
+    let f = with_extrinsic(&mesh, 5);
+    let ranges = f.value_ranges();
+    let n = f.feature_count();
+    assert_eq!(ranges.iter().filter(|r| r.is_some()).count(), 5);
+    assert!(ranges[..n - 5].iter().all(Option::is_none));
+    for weighting in [BandWeighting::Count, BandWeighting::Area] {
+        let mut o = BandOptions::default();
+        o.weighting = weighting;
+        let t = band_table(&f, &o).unwrap();
+        let ranked = match weighting {
+            BandWeighting::Count => equal_count_bands(&f.values, n, f.vertices, 20),
+            BandWeighting::Area => {
+                area_weighted_bands(&f.values, &f.vertex_areas, n, f.vertices, 20)
+            }
+        }
+        .unwrap();
+        for (k, range) in ranges.iter().enumerate() {
+            let want: Vec<u8> = match range {
+                Some(r) => fixed_range_bands(f.feature(k), *r, 20).unwrap(),
+                None => (0..f.vertices).map(|v| ranked.label(v, k)).collect(),
+            };
+            let got: Vec<u8> = (0..f.vertices).map(|v| t.label(v, k)).collect();
+            assert_eq!(got, want, "feature {k}");
+        }
+    }
+}
+
+/// The reason for fixed-range bands: a patch's normal bands do not depend on what else the
+/// shape holds. A horizontal plate alone and the same plate beside a vertical wall give its
+/// vertices the same normal bands (rank bands would move them: checked, so the test can fail).
+#[test]
+fn a_patch_keeps_its_normal_bands_whatever_else_the_shape_holds() {
+    let plate = common::mesh::grid(8);
+    let wall_positions: Vec<[f64; 3]> = plate
+        .positions()
+        .iter()
+        .map(|p| [p[0] + 2.0, p[2], p[1]])
+        .collect();
+    let offset = plate.vertex_count() as u32;
+    let mut positions = plate.positions().to_vec();
+    positions.extend(wall_positions);
+    let mut faces = plate.faces().to_vec();
+    faces.extend(plate.faces().iter().map(|t| t.map(|i| i + offset)));
+    let both = TriMesh::new(positions, faces).unwrap();
+    let (a, b) = (with_extrinsic(&plate, 6), with_extrinsic(&both, 6));
+    let (ta, tb) = (
+        band_table(&a, &BandOptions::default()).unwrap(),
+        band_table(&b, &BandOptions::default()).unwrap(),
+    );
+    let ranges = a.value_ranges();
+    let normal_columns: Vec<usize> = (0..a.feature_count())
+        .filter(|&k| ranges[k].is_some())
+        .collect();
+    assert_eq!(normal_columns.len(), 6);
+    let mut rank_moved = false;
+    for &k in &normal_columns {
+        let ra = equal_count_bands(a.feature(k), 1, a.vertices, 20).unwrap();
+        let rb = equal_count_bands(&b.feature(k)[..a.vertices], 1, a.vertices, 20).unwrap();
+        let rb_in_both = equal_count_bands(b.feature(k), 1, b.vertices, 20).unwrap();
+        rank_moved |= (0..a.vertices).any(|v| ra.labels[v] != rb_in_both.labels[v]);
+        assert_eq!(
+            ra, rb,
+            "the plate's normal values are the same in both meshes"
+        );
+        for v in 0..a.vertices {
+            assert_eq!(ta.label(v, k), tb.label(v, k), "feature {k}, vertex {v}");
+        }
+    }
+    assert!(
+        rank_moved,
+        "rank bands would have moved the plate's normal bands"
+    );
 }

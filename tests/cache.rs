@@ -334,7 +334,7 @@ fn a_cache_entry_declaring_a_huge_string_is_refused_not_an_abort() {
     assert_eq!(again.outcome, CacheOutcome::Hit);
 }
 
-// The compact layout (format version 4)
+// The compact layout (format version 4 and later)
 
 /// Every bit of the shape's data: spectrum, descriptors (values and metadata), band table.
 /// `PartialEq` on `f64` would take `0.0` for `-0.0`; this does not.
@@ -535,7 +535,7 @@ fn the_bands_entry_is_compressed() {
 fn entries_of_another_format_version_are_stale_and_recomputed() {
     use coseg::cache::{FORMAT_VERSION, bands_path};
     use coseg::pipeline::load_or_compute_bands;
-    assert_eq!(FORMAT_VERSION, 4);
+    assert_eq!(FORMAT_VERSION, 5);
     let dir = tempfile::tempdir().unwrap();
     let (m, o) = (mesh(), opts());
     let first = load_or_compute_bands(&m, &o, dir.path()).unwrap().data;
@@ -545,14 +545,14 @@ fn entries_of_another_format_version_are_stale_and_recomputed() {
         std::fs::read(&full).unwrap(),
         std::fs::read(&compact).unwrap(),
     ];
-    for version in [3u32, 5] {
+    for version in [3u32, 4, 6] {
         for (path, bytes) in [(&full, &good[0]), (&compact, &good[1])] {
             let mut old = bytes.clone();
             old[8..12].copy_from_slice(&version.to_le_bytes());
             std::fs::write(path, &old).unwrap();
         }
         let r = load_or_compute_bands(&m, &o, dir.path()).unwrap();
-        let needle = format!("stale format version {version} (current 4)");
+        let needle = format!("stale format version {version} (current 5)");
         assert_eq!(
             r.outcome,
             CacheOutcome::Recomputed {

@@ -1,4 +1,4 @@
-use super::{BandError, BandTable, area_weighted_bands, equal_count_bands};
+use super::{BandError, BandTable, area_weighted_bands, equal_count_bands, fixed_range_bands};
 use crate::features::Descriptors;
 
 /// How a feature's sorted order is cut into bands.
@@ -32,7 +32,9 @@ impl Default for BandOptions {
 }
 
 /// The band table of a shape's descriptors: [`equal_count_bands`] or [`area_weighted_bands`]
-/// (with the descriptors' unit-area vertex areas) on every feature. Deterministic; features are
+/// (with the descriptors' unit-area vertex areas) on every feature, except the features with a
+/// fixed value range ([`Descriptors::value_ranges`]: the extrinsic family's normal columns),
+/// which get [`fixed_range_bands`] whatever the weighting. Deterministic; features are
 /// processed in parallel.
 ///
 /// ```
@@ -54,7 +56,7 @@ pub fn band_table(
     options: &BandOptions,
 ) -> Result<BandTable, BandError> {
     let (n, d) = (descriptors.feature_count(), descriptors.vertices);
-    match options.weighting {
+    let mut table = match options.weighting {
         BandWeighting::Count => equal_count_bands(&descriptors.values, n, d, options.bands),
         BandWeighting::Area => area_weighted_bands(
             &descriptors.values,
@@ -63,5 +65,20 @@ pub fn band_table(
             d,
             options.bands,
         ),
+    }?;
+    for (f, range) in descriptors.value_ranges().into_iter().enumerate() {
+        if let Some(range) = range {
+            let column = fixed_range_bands(descriptors.feature(f), range, options.bands).map_err(
+                |e| match e {
+                    BandError::NaN { vertex, .. } => BandError::NaN { feature: f, vertex },
+                    e => e,
+                },
+            )?;
+            for (v, b) in column.into_iter().enumerate() {
+                table.labels[v * n + f] = b;
+            }
+        }
     }
+    debug_assert_eq!(table.vertices, d);
+    Ok(table)
 }

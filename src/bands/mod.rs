@@ -1,16 +1,20 @@
 //! Band-label tables: each feature's sorted order on a shape cut into `K` equal blocks, one
 //! `u8` label per (vertex, feature).
 //!
-//! Only ranks matter: any monotone transform of a feature gives the same table.
+//! Only ranks matter: any monotone transform of a feature gives the same table — except for
+//! the columns whose values mean the same on every shape (normal orientations), which
+//! [`band_table`] cuts by value over their fixed range ([`fixed_range_bands`]).
 
 use thiserror::Error;
 
 mod area_weighted_bands;
 mod band_table;
+mod fixed_range_bands;
 mod synthetic_band_table;
 
 pub use area_weighted_bands::area_weighted_bands;
 pub use band_table::{BandOptions, BandWeighting, band_table};
+pub use fixed_range_bands::fixed_range_bands;
 pub use synthetic_band_table::synthetic_band_table;
 
 /// Errors of the band stage.
@@ -40,6 +44,9 @@ pub enum BandError {
     /// More vertices than a `u32` index can address.
     #[error("{0} vertices exceed the u32 index range")]
     TooManyVertices(usize),
+    /// The fixed value range of a feature is not finite with `lo < hi`.
+    #[error("bad fixed band range [{0}, {1}]: must be finite with lo < hi")]
+    BadRange(f64, f64),
     /// A feature value is NaN.
     #[error("feature {feature} is NaN at vertex {vertex}")]
     NaN {

@@ -129,6 +129,39 @@ impl Descriptors {
         Ok(())
     }
 
+    /// The fixed value range of every feature, in table order: `Some([lo, hi])` for the
+    /// extrinsic family's normal columns ([`fixed_value_range`](super::fixed_value_range)),
+    /// whose bands are cut by value, `None` (rank bands) for every other feature.
+    ///
+    /// ```
+    /// use coseg::{mesh::TriMesh, spectral::dense_spectrum};
+    /// use coseg::features::{descriptors, extrinsic_features, DescriptorOptions, ExtrinsicOptions};
+    /// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.]], vec![[0,1,2],[0,2,3]]).unwrap();
+    /// let mut opts = DescriptorOptions::default();
+    /// (opts.hks_count, opts.wks_count, opts.curvature_count) = (2, 2, 2);
+    /// let mut d = descriptors(&m, &dense_spectrum(&m, 4).unwrap(), &opts).unwrap();
+    /// let mut o = ExtrinsicOptions::default();
+    /// (o.directions, o.normal_directions) = (2, 3);
+    /// let c = extrinsic_features(&m, &o).unwrap();
+    /// let n = c.len(); // 2 heights, 2 distances, 3 normal columns
+    /// d.append(c, [n, 0, 0]).unwrap();
+    /// let r = d.value_ranges();
+    /// assert_eq!(r[..6 + 4], [None; 10]);
+    /// assert_eq!(r[10..], [Some([0.0, 1.0]); 3]);
+    /// ```
+    pub fn value_ranges(&self) -> Vec<Option<[f64; 2]>> {
+        let extrinsic = self.family_counts[0];
+        std::iter::repeat_n(None, self.spectral_count())
+            .chain(self.extra_names.iter().enumerate().map(|(i, name)| {
+                if i < extrinsic {
+                    super::fixed_value_range(name)
+                } else {
+                    None
+                }
+            }))
+            .collect()
+    }
+
     /// Feature `f` (length `d`).
     pub fn feature(&self, f: usize) -> &[f64] {
         &self.values[f * self.vertices..(f + 1) * self.vertices]

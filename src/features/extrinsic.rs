@@ -225,6 +225,19 @@ fn pca_axes(
     axes
 }
 
+/// Name prefix of the normal columns `|n·u|` (`ext_nrm_000`…).
+const NORMAL_PREFIX: &str = "ext_nrm_";
+
+/// The fixed value range of an extrinsic column, if its values mean the same on every shape:
+/// `[0, 1]` for the normal columns `|n·u|` (1 = the surface faces along `u`), `None` for the
+/// heights and distances, whose scale is the shape's. The band stage cuts fixed-range columns
+/// by value ([`fixed_range_bands`](crate::bands::fixed_range_bands)), not by rank, so a
+/// horizontal patch is in the top band of the vertical direction on every shape, whatever
+/// share of the surface it is (measured on the aligned sets in docs/FEATURES.md).
+pub fn fixed_value_range(name: &str) -> Option<[f64; 2]> {
+    name.starts_with(NORMAL_PREFIX).then_some([0.0, 1.0])
+}
+
 /// Extrinsic per-vertex features of `mesh`: heights along [`height_directions`] in the shape's
 /// [`Frame`] (`ext_dir_000`…), then the distance to the centroid (`ext_centroid`) and to the
 /// up axis through it (`ext_axis`), as enabled.
@@ -314,7 +327,7 @@ pub fn extrinsic_features(
             .iter()
             .enumerate()
         {
-            names.push(format!("ext_nrm_{i:03}"));
+            names.push(format!("{NORMAL_PREFIX}{i:03}"));
             values.extend(
                 normals
                     .iter()

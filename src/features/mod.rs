@@ -32,7 +32,8 @@ mod wave_kernel_signature;
 pub use columns::FeatureColumns;
 pub use descriptors::{DescriptorOptions, Descriptors, FeatureKind, descriptors};
 pub use extrinsic::{
-    Alignment, Axis, ExtrinsicOptions, Frame, extrinsic_features, height_directions, shape_frame,
+    Alignment, Axis, ExtrinsicOptions, Frame, extrinsic_features, fixed_value_range,
+    height_directions, shape_frame,
 };
 pub use families::{
     FamilyWeights, FeatureFamilies, UserSource, parse_alignment, parse_families,

@@ -178,7 +178,7 @@ fn table_fits(t: &BandTable, vertices: usize) -> bool {
         && t.labels.iter().all(|&l| (l as usize) < t.bands)
 }
 
-/// What the full cache entry holds (format version 4): the spectrum with its eigenvectors
+/// What the full cache entry holds (format version 5): the spectrum with its eigenvectors
 /// in `f32`, the columns of the families that are not cheap to recompute (sdf, user), and the
 /// band table (deflated). The rest of [`ShapeData`] (the spectral and extrinsic descriptors)
 /// is recomputed from it on a warm load by [`StoredShape::into_shape_data`], with the same
