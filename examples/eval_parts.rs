@@ -2,10 +2,10 @@
 //!
 //! ```text
 //! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N]
-//!     [--features F --up AXIS] [--starts N] [--keep-sizes TOL] [--detail] MODE...
+//!     [--features F --up AXIS [--normals N]] [--starts N] [--keep-sizes TOL] [--detail] MODE...
 //! ```
-//! `--features`/`--up` select the feature families as `coseg segment` does (e.g.
-//! `--features spectral,extrinsic --up y`), `--starts` its several starts, `--keep-sizes TOL`
+//! `--features`/`--up`/`--normals` select the feature families as `coseg segment` does (e.g.
+//! `--features spectral,extrinsic --up y --normals 16`), `--starts` its several starts, `--keep-sizes TOL`
 //! the size-aware refinement (`RefineSizes::Keep`, `coseg segment --refine-sizes keep:TOL`;
 //! without it the free best response). `--detail` prints, for families, each shape's own
 //! purity / coverage and the pooled area table (region × grouped part, % of a shape).
@@ -179,10 +179,12 @@ fn main() -> Res<()> {
     let (mut features, mut up, mut starts) = ("spectral".to_string(), "y".to_string(), 1);
     let mut keep: Option<f64> = None;
     let mut detail = false;
+    let mut normals = 0;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--features" => features = args.next().ok_or("--features F")?,
             "--up" => up = args.next().ok_or("--up AXIS")?,
+            "--normals" => normals = args.next().ok_or("--normals N")?.parse()?,
             "--starts" => starts = args.next().ok_or("--starts N")?.parse()?,
             "--detail" => detail = true,
             "--keep-sizes" => keep = Some(args.next().ok_or("--keep-sizes TOL")?.parse()?),
@@ -199,7 +201,7 @@ fn main() -> Res<()> {
     };
     let mut pipeline = ShapePipelineOptions::default();
     let directions = coseg::features::ExtrinsicOptions::default().directions;
-    pipeline.set_families(&features, &up, directions, 0, "")?;
+    pipeline.set_families(&features, &up, directions, normals, "")?;
     let loaded = load_collection(&shapes, &pipeline, &cache, |_, _, _| {})?;
     for s in &loaded.skipped {
         eprintln!("skipped: {}", s.error);
