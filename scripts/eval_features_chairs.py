@@ -94,10 +94,16 @@ def segment(out, data):
         per_shape[s] = local
     labels, regions = sorted(labels), sorted(r for r in regions if r >= 0)
     best, best_map = -1.0, None
-    for perm in itertools.permutations(regions, len(labels)) if len(regions) >= len(labels) else []:
-        score = sum(conf.get((r, l), 0.0) for r, l in zip(perm, labels))
+    # One-to-one in either direction: with fewer region ids than labels (a run whose last
+    # region is empty everywhere) some labels stay unmatched and count as wrong.
+    if len(regions) >= len(labels):
+        pairings = (list(zip(perm, labels)) for perm in itertools.permutations(regions, len(labels)))
+    else:
+        pairings = (list(zip(regions, perm)) for perm in itertools.permutations(labels, len(regions)))
+    for pairs in pairings:
+        score = sum(conf.get(rl, 0.0) for rl in pairs)
         if score > best:
-            best, best_map = score, dict(zip(perm, labels))
+            best, best_map = score, dict(pairs)
     n = len(per_shape)
     shape_acc = {s: sum(a for (r, l), a in c.items() if best_map.get(r) == l) for s, c in per_shape.items()}
     worst = min(shape_acc.items(), key=lambda kv: kv[1])

@@ -463,6 +463,42 @@ fn family_weights_give_each_family_its_total_share() {
     assert_eq!(small_pipeline().feature_weights(12), None);
 }
 
+/// The normal columns are a family of their own in the weights: position (heights and
+/// distances) and orientation each get their share, whatever the column counts, and the
+/// columns the weights treat as normals are the ones named `ext_nrm_*` (the last extrinsic
+/// columns).
+#[test]
+fn normal_columns_get_a_family_share_of_their_own() {
+    let mut o = small_pipeline();
+    o.set_families("spectral,extrinsic", "y", 6, 4, "normals=2")
+        .unwrap();
+    // 12 spectral, 6 heights + 2 distances, 4 normals.
+    let w = o.feature_weights(12 + 8 + 4).unwrap();
+    assert_eq!(w.len(), 24);
+    let share = |r: std::ops::Range<usize>| w[r].iter().sum::<f64>();
+    assert!((share(0..12) - 1.0).abs() < 1e-12);
+    assert!((share(12..20) - 1.0).abs() < 1e-12);
+    assert!((share(20..24) - 2.0).abs() < 1e-12);
+    assert!(w[12..20].iter().all(|&x| x == 1.0 / 8.0));
+    assert!(w[20..].iter().all(|&x| x == 2.0 / 4.0));
+    let c = extrinsic_features(&blob(1), o.families.extrinsic.as_ref().unwrap()).unwrap();
+    let normal_names: Vec<bool> = c.names.iter().map(|n| n.starts_with("ext_nrm_")).collect();
+    assert_eq!(normal_names, [vec![false; 8], vec![true; 4]].concat());
+    // Without normals the extrinsic family keeps one share over its columns, as before.
+    let mut p = small_pipeline();
+    p.set_families("spectral,extrinsic", "y", 6, 0, "").unwrap();
+    let w = p.feature_weights(12 + 8).unwrap();
+    assert!(w[12..].iter().all(|&x| x == 1.0 / 8.0));
+    // The extrinsic family alone with normals: two families, so weights are given.
+    let mut q = small_pipeline();
+    q.set_families("extrinsic", "y", 6, 4, "").unwrap();
+    let w = q.feature_weights(8 + 4).unwrap();
+    assert!(w[..8].iter().all(|&x| x == 1.0 / 8.0) && w[8..].iter().all(|&x| x == 0.25));
+    let mut fw = coseg::features::FamilyWeights::default();
+    coseg::features::parse_family_weights("normals=0.5", &mut fw).unwrap();
+    assert_eq!((fw.extrinsic, fw.normals), (1.0, 0.5));
+}
+
 #[test]
 fn normal_columns_are_absolute_cosines_whatever_the_winding() {
     // A horizontal square (normal ±y, the up axis) and a vertical one (normal ±z) far apart.

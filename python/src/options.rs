@@ -292,6 +292,7 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     let weights = PyDict::new(py);
     weights.set_item("spectral", w.spectral)?;
     weights.set_item("extrinsic", w.extrinsic)?;
+    weights.set_item("normals", w.normals)?;
     weights.set_item("sdf", w.sdf)?;
     weights.set_item("user", w.user)?;
     d.set_item("family_weights", weights)?;

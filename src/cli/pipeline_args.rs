@@ -44,8 +44,9 @@ pub struct PipelineArgs {
     /// non-negative; for CAD exports and poor triangulations). See docs/FEATURES.md.
     #[arg(long, default_value = "cotan")]
     laplacian: String,
-    /// Family weights in the affinity, e.g. spectral=1,extrinsic=2 (a family's total share;
-    /// default 1 each). Used by `coseg segment`, `coseg propagate` and `coseg pair` (all its
+    /// Family weights in the affinity, e.g. spectral=1,extrinsic=2,normals=1 (a family's total
+    /// share; default 1 each; `normals` = the extrinsic family's `--normals` columns, weighted
+    /// as a family of their own). Used by `coseg segment`, `coseg propagate` and `coseg pair` (all its
     /// stages).
     #[arg(long, default_value = "")]
     family_weights: String,

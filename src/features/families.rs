@@ -5,7 +5,9 @@
 //! extrinsic, sdf, user — each family's columns in its own order, so under the same options
 //! every shape of a collection has the same column names in the same positions and the
 //! affinity pairs them by name. A family's weight is its **total** share of the affinity: each
-//! of its `n` columns gets `weight / n` (see [`FeatureFamilies::feature_weights`]).
+//! of its `n` columns gets `weight / n` (see [`FeatureFamilies::feature_weights`]). The extrinsic
+//! family's normal columns (orientation, `--normals`) are weighted as a family of their own, so
+//! orientation and position (heights, distances) each get a share whatever their column counts.
 
 use super::{
     ExtrinsicOptions, FeatureColumns, FeatureError, SdfOptions, extrinsic_features,
@@ -35,12 +37,23 @@ pub enum UserSource {
 pub struct FamilyWeights {
     /// HKS + WKS + curvature together.
     pub spectral: f64,
-    /// Extrinsic columns together.
+    /// Extrinsic position columns together (heights `ext_dir_*`, distances `ext_centroid`,
+    /// `ext_axis`).
     pub extrinsic: f64,
+    /// Extrinsic normal columns `ext_nrm_*` together (orientation, [`ExtrinsicOptions::normal_directions`]):
+    /// a share of their own, not taken from the positions'. Measured in docs/PROPAGATION.md
+    /// ("Normals as a family of their own").
+    #[serde(default = "one")]
+    pub normals: f64,
     /// SDF columns together.
     pub sdf: f64,
     /// User columns together.
     pub user: f64,
+}
+
+/// Serde default of a family weight missing from older files.
+fn one() -> f64 {
+    1.0
 }
 
 impl Default for FamilyWeights {
@@ -48,6 +61,7 @@ impl Default for FamilyWeights {
         Self {
             spectral: 1.0,
             extrinsic: 1.0,
+            normals: 1.0,
             sdf: 1.0,
             user: 1.0,
         }
@@ -193,20 +207,34 @@ impl FeatureFamilies {
 
     /// Per-column weights for a table of `spectral` spectral columns followed by
     /// `counts = [extrinsic, sdf, user]` columns: each column gets its family's weight over the
-    /// family's column count. `None` when only one family has columns (equal weights: the
-    /// affinity's exact integer path, bit-identical to a single-family table).
+    /// family's column count. The last [`ExtrinsicOptions::normal_directions`] extrinsic
+    /// columns (the normals, which [`extrinsic_features`] puts last) count as the `normals`
+    /// family. `None` when only one family has columns (equal weights: the affinity's exact
+    /// integer path, bit-identical to a single-family table).
     ///
     /// ```
-    /// use coseg::features::FeatureFamilies;
-    /// let f = FeatureFamilies::default();
+    /// use coseg::features::{ExtrinsicOptions, FeatureFamilies};
+    /// let mut f = FeatureFamilies::default();
     /// assert_eq!(f.feature_weights(300, [0, 0, 0]), None);
     /// let w = f.feature_weights(2, [4, 0, 0]).unwrap();
     /// assert_eq!(w, vec![0.5, 0.5, 0.25, 0.25, 0.25, 0.25]);
+    /// // Two of the four extrinsic columns are normals: a family of their own.
+    /// let mut e = ExtrinsicOptions::default();
+    /// e.normal_directions = 2;
+    /// f.extrinsic = Some(e);
+    /// let w = f.feature_weights(2, [4, 0, 0]).unwrap();
+    /// assert_eq!(w, vec![0.5, 0.5, 0.5, 0.5, 0.5, 0.5]);
     /// ```
     pub fn feature_weights(&self, spectral: usize, counts: [usize; 3]) -> Option<Vec<f64>> {
+        let normals = self
+            .extrinsic
+            .as_ref()
+            .map_or(0, |e| e.normal_directions)
+            .min(counts[0]);
         let fams = [
             (spectral, self.weights.spectral),
-            (counts[0], self.weights.extrinsic),
+            (counts[0] - normals, self.weights.extrinsic),
+            (normals, self.weights.normals),
             (counts[1], self.weights.sdf),
             (counts[2], self.weights.user),
         ];
@@ -296,8 +324,8 @@ pub fn parse_alignment(s: &str) -> Result<super::Alignment, FeatureError> {
     }
 }
 
-/// Parses family weights `spectral=1,extrinsic=2,sdf=0.5,user=1` (any subset; the others keep
-/// their value in `weights`). Weights must be finite and non-negative.
+/// Parses family weights `spectral=1,extrinsic=2,normals=1,sdf=0.5,user=1` (any subset; the
+/// others keep their value in `weights`). Weights must be finite and non-negative.
 ///
 /// ```
 /// use coseg::features::{parse_family_weights, FamilyWeights};
@@ -318,6 +346,7 @@ pub fn parse_family_weights(s: &str, weights: &mut FamilyWeights) -> Result<(), 
         let slot = match name.trim() {
             "spectral" => &mut weights.spectral,
             "extrinsic" => &mut weights.extrinsic,
+            "normals" => &mut weights.normals,
             "sdf" => &mut weights.sdf,
             "user" => &mut weights.user,
             _ => return Err(bad()),
