@@ -6,7 +6,8 @@
 //! # Near-isometric classes (identity ground truth): a part decomposition of the first shape
 //! # (K farthest-point Voronoi cells, --parts K, or with --parts-from features K clusters of
 //! # its own band table, its segmentation in feature space) carried to the others.
-//! cargo run --release --example eval_propagate -- identity [--parts 6] MESH...
+//! # With --map-step: then the library's map step (coseg propagate --map-step) on every target.
+//! cargo run --release --example eval_propagate -- identity [--parts 6] [--map-step] MESH...
 //! # Timing (warm cache): propagate from the first mesh, update adding the second.
 //! cargo run --release --example eval_propagate -- bench [--seg DIR] [--reps 3] MESH...
 //! # A shipped collection (per-vertex `<stem>.labels.txt` beside the meshes), as `chairs`.
@@ -226,6 +227,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut directions = None;
     let mut normals = 0usize;
     let mut parts_from = "voronoi".to_string();
+    let mut map_step = false;
     let mut swaps: Vec<(Vec<String>, i32, i32)> = Vec::new();
     let (mut seg, mut reps): (Option<PathBuf>, usize) = (None, 3);
     while let Some(a) = args.next() {
@@ -254,6 +256,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--seed" => seed = val()?.parse()?,
             "--parts" => parts = val()?.parse()?,
             "--parts-from" => parts_from = val()?,
+            "--map-step" => map_step = true,
             "--seg" => seg = Some(PathBuf::from(val()?)),
             "--reps" => reps = val()?.parse()?,
             "--per-target" => per_target = true,
@@ -426,7 +429,60 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .accuracy
             };
             let t = Instant::now();
-            let r = run(&set, &[0], &ann, &score, &options)?;
+            let r = if map_step {
+                // The library's map step from the source (shape 0) to every target, as
+                // `coseg propagate --map-step` runs it.
+                let n = set.names.len();
+                let annv: Vec<Option<Vec<i32>>> =
+                    (0..n).map(|i| (i == 0).then(|| truth.clone())).collect();
+                let p = propagate_labels(&set.graph, set.smoothers.as_deref(), &annv, &options)?;
+                let src = coseg::pipeline::load_or_compute(&set.meshes[0], &pipeline, &cache)?.data;
+                let o = coseg::propagate::MapStepOptions::default();
+                let out: Vec<(usize, f64, f64, f64, bool)> = (1..n)
+                    .into_par_iter()
+                    .map(|i| {
+                        let data =
+                            coseg::pipeline::load_or_compute(&set.meshes[i], &pipeline, &cache)
+                                .unwrap()
+                                .data;
+                        let a = coseg::propagate::MapStepShape {
+                            spectrum: &src.spectrum,
+                            positions: set.meshes[0].positions(),
+                            labels: &truth,
+                            descriptors: None,
+                        };
+                        let b = coseg::propagate::MapStepShape {
+                            spectrum: &data.spectrum,
+                            positions: set.meshes[i].positions(),
+                            labels: &p.labels[i],
+                            descriptors: None,
+                        };
+                        let (l, rep) =
+                            coseg::propagate::map_step(&a, &b, &set.graph.node(i).areas, 0, &o)
+                                .unwrap();
+                        (
+                            i,
+                            score(i, &p.labels[i]),
+                            score(i, &l),
+                            rep.agreement,
+                            rep.applied,
+                        )
+                    })
+                    .collect();
+                for &(i, before, after, agree, applied) in &out {
+                    println!(
+                        "  {}: {:.1} % -> {:.1} % (agreement {:.1} %, {})",
+                        set.names[i],
+                        100.0 * before,
+                        100.0 * after,
+                        100.0 * agree,
+                        if applied { "kept" } else { "rejected" }
+                    );
+                }
+                out.iter().map(|&(i, _, a, _, _)| (i, a)).collect()
+            } else {
+                run(&set, &[0], &ann, &score, &options)?
+            };
             let (w, wv) = worst(&r);
             println!(
                 "| source {} ({parts} {parts_from} parts) | {} targets | mean {:.1} % | worst {} {:.1} % | {:.2} s |",

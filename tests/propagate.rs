@@ -436,3 +436,171 @@ fn sources_like_the_target_outweigh_unlike_ones() {
     assert!(r >= d - 4, "{r} of {d}");
     assert!(rq < d / 2, "without similarity weights: {rq} of {d}");
 }
+
+/// Three parts of the asymmetric blob by its x coordinate, and the same parts with the
+/// strip `0.35 ≤ x < 0.6` given part 1 instead of 2 (a misplaced boundary, as a propagation
+/// leaves one).
+fn blob_parts(mesh: &coseg::mesh::TriMesh) -> (Vec<i32>, Vec<i32>) {
+    let part = |x: f64| {
+        if x < -0.4 {
+            0
+        } else if x < 0.35 {
+            1
+        } else {
+            2
+        }
+    };
+    let truth: Vec<i32> = mesh.positions().iter().map(|p| part(p[0])).collect();
+    let rough = mesh
+        .positions()
+        .iter()
+        .map(|p| {
+            if (0.35..0.6).contains(&p[0]) {
+                1
+            } else {
+                part(p[0])
+            }
+        })
+        .collect();
+    (truth, rough)
+}
+
+/// The map step on an exact isometry: the target is the source blob with its vertices
+/// permuted and a misplaced boundary. The map carries the source's parts back, so the strip
+/// is corrected and at least 99 % of the area agrees with the truth; the report says the map
+/// was kept. With `min_agreement = 1` the same map is rejected and the rough labels come back
+/// unchanged, bit for bit; bad options are errors.
+#[test]
+fn map_step_corrects_a_misplaced_boundary_on_an_isometric_copy() {
+    use common::features::{blob, permutation, permute_mesh};
+    use coseg::propagate::{MapStepOptions, MapStepShape, map_step};
+    use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
+    let mesh = blob(3);
+    let n = mesh.vertex_count();
+    let perm = permutation(n, 5);
+    let copy = permute_mesh(&mesh, &perm);
+    let (truth, _) = blob_parts(&mesh);
+    let (truth_copy, rough) = blob_parts(&copy);
+    let mut so = SpectrumOptions::default();
+    so.eigenpairs = 40;
+    let (sa, sb) = (
+        laplace_beltrami_spectrum(&mesh, &so).unwrap(),
+        laplace_beltrami_spectrum(&copy, &so).unwrap(),
+    );
+    let source = MapStepShape {
+        spectrum: &sa,
+        positions: mesh.positions(),
+        labels: &truth,
+        descriptors: None,
+    };
+    let target = MapStepShape {
+        spectrum: &sb,
+        positions: copy.positions(),
+        labels: &rough,
+        descriptors: None,
+    };
+    let areas = copy.vertex_areas();
+    let accuracy = |l: &[i32]| {
+        vertex_label_agreement(&copy, &truth_copy, l)
+            .unwrap()
+            .accuracy
+    };
+    let before = accuracy(&rough);
+    assert!(before < 0.95, "the strip must matter: {before}");
+    let o = MapStepOptions::default();
+    let (labels, report) = map_step(&source, &target, &areas, 7, &o).unwrap();
+    assert!(report.applied && report.source == 7, "{report:?}");
+    assert!(
+        (report.agreement - before).abs() < 0.02,
+        "{report:?} vs {before}"
+    );
+    let after = accuracy(&labels);
+    assert!(
+        after >= 0.99,
+        "after the map step {after} (before {before})"
+    );
+    // Deterministic.
+    assert_eq!(map_step(&source, &target, &areas, 7, &o).unwrap().0, labels);
+    let mut strict = MapStepOptions::default();
+    strict.min_agreement = 1.0;
+    let (kept, report) = map_step(&source, &target, &areas, 7, &strict).unwrap();
+    assert!(!report.applied);
+    assert_eq!(kept, rough);
+    strict.min_agreement = 1.5;
+    assert!(map_step(&source, &target, &areas, 7, &strict).is_err());
+    assert!(map_step(&source, &target, &areas[1..], 7, &o).is_err());
+}
+
+/// `coseg propagate --map-step` end to end, the real binary on a folder of the blob and two
+/// permuted copies (exact isometries) with a rough annotation-free start: every copy's map is
+/// kept and recorded in `summary.json` with its source, the labels reach ≥ 99 % of the truth,
+/// and without the flag the summary has no map-step field (the default output is unchanged).
+#[test]
+fn coseg_propagate_map_step_on_isometric_copies() {
+    use common::features::{blob, permutation, permute_mesh};
+    let dir = tempfile::tempdir().unwrap();
+    let shapes = dir.path().join("shapes");
+    std::fs::create_dir(&shapes).unwrap();
+    let mesh = blob(3);
+    let (truth, _) = blob_parts(&mesh);
+    coseg::mesh::write_mesh(shapes.join("a.off"), &mesh, &[]).unwrap();
+    coseg::labels::write_vertex_labels(dir.path(), "a", &truth).unwrap();
+    let mut copies = Vec::new();
+    for (k, seed) in [(1, 11u64), (2, 12)] {
+        let perm = permutation(mesh.vertex_count(), seed);
+        let copy = permute_mesh(&mesh, &perm);
+        coseg::mesh::write_mesh(shapes.join(format!("c{k}.off")), &copy, &[]).unwrap();
+        let truth_copy = blob_parts(&copy).0;
+        copies.push((format!("c{k}"), copy, truth_copy));
+    }
+    let run = |out: &std::path::Path, map: bool| {
+        let mut args: Vec<std::ffi::OsString> = vec![
+            "propagate".into(),
+            shapes.clone().into(),
+            "--labels".into(),
+            dir.path().join("a.labels.txt").into(),
+            "-o".into(),
+            out.into(),
+            "--cache".into(),
+            dir.path().join("cache").into(),
+            "--eigenpairs".into(),
+            "40".into(),
+            "--no-pictures".into(),
+        ];
+        if map {
+            args.push("--map-step".into());
+        }
+        let refs: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
+        let r = coseg(&refs);
+        assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
+        serde_json::from_str::<serde_json::Value>(
+            &std::fs::read_to_string(out.join("summary.json")).unwrap(),
+        )
+        .unwrap()
+    };
+    let with = dir.path().join("with");
+    let summary = run(&with, true);
+    assert_eq!(summary["map_step"]["min_agreement"], serde_json::json!(0.8));
+    for (name, copy, truth_copy) in &copies {
+        let shape = summary["shapes"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["name"] == serde_json::json!(name))
+            .unwrap();
+        assert_eq!(
+            shape["map_step"]["applied"],
+            serde_json::json!(true),
+            "{shape}"
+        );
+        assert_eq!(shape["map_source"], serde_json::json!("a"));
+        let got = read_labels(with.join(format!("{name}.labels.txt"))).unwrap();
+        let acc = vertex_label_agreement(copy, truth_copy, &got)
+            .unwrap()
+            .accuracy;
+        assert!(acc >= 0.99, "{name}: {acc}");
+    }
+    let without = run(&dir.path().join("without"), false);
+    assert!(without.get("map_step").is_none());
+    assert!(without["shapes"][1].get("map_step").is_none());
+}

@@ -800,6 +800,7 @@ fn propagate<'py>(
                 warnings.extend(loaded.warnings);
                 let solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, &opts)?;
                 warnings.extend(solved.warnings);
+                let n_shapes = loaded.meshes.len();
                 let result = PropagatedCollection {
                     paths: loaded.files.iter().map(PathBuf::from).collect(),
                     meshes: loaded.meshes,
@@ -811,6 +812,10 @@ fn propagate<'py>(
                     skipped: Vec::new(),
                     // Shapes in memory: `outcomes` below says where their data came from.
                     outcomes: Vec::new(),
+                    // The map step needs the shapes' spectra from the folder path's cache;
+                    // arrays in memory do not run it.
+                    map_steps: vec![None; n_shapes],
+                    map_step: None,
                     warnings,
                 };
                 Ok((result, loaded.outcomes))

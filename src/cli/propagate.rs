@@ -7,7 +7,7 @@ use coseg::graph::GraphOptions;
 use coseg::labels::PartNames;
 use coseg::output::{PropagationSummary, write_propagation, write_visuals};
 use coseg::propagate::{
-    PartScore, PropagateCollectionOptions, PropagateOptions, propagate_collection,
+    MapStepOptions, PartScore, PropagateCollectionOptions, PropagateOptions, propagate_collection,
 };
 use coseg::render::{RenderOptions, RenderShape};
 use std::path::PathBuf;
@@ -72,6 +72,15 @@ pub struct PropagateArgs {
     /// Weight of the target's own parts in the refit, relative to the votes.
     #[arg(long, default_value_t = PropagateOptions::default().refit_weight)]
     refit_weight: f64,
+    /// For near-isometric collections (posed scans, TOSCA, FAUST): carry each unlabelled
+    /// shape's labels point by point from its nearest source through a point map, kept where
+    /// they agree with the propagation on at least --map-agreement of the area. Not for
+    /// man-made collections (docs/PROPAGATION.md, "Map step").
+    #[arg(long)]
+    map_step: bool,
+    /// Smallest agreement, in [0, 1], for the map step's labels to be kept.
+    #[arg(long, default_value_t = MapStepOptions::default().min_agreement)]
+    map_agreement: f64,
     #[command(flatten)]
     pipeline: super::pipeline_args::PipelineArgs,
 }
@@ -95,6 +104,11 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
     options.propagate.area_weighted = args.area_weighted;
     options.propagate.refit_rounds = args.refit_rounds;
     options.propagate.refit_weight = args.refit_weight;
+    if args.map_step {
+        let mut m = MapStepOptions::default();
+        m.min_agreement = args.map_agreement;
+        options.map_step = Some(m);
+    }
     options.cache_dir = Some(
         args.cache
             .clone()

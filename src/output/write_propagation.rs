@@ -4,7 +4,7 @@ use super::{OutputError, region_colors, write_summary};
 use crate::graph::GraphOptions;
 use crate::labels::{LabelKind, vertices_to_faces, write_face_labels, write_vertex_labels};
 use crate::mesh::{PlyVertexProperty, write_mesh};
-use crate::propagate::{PropagateOptions, PropagatedCollection};
+use crate::propagate::{MapStepOptions, MapStepReport, PropagateOptions, PropagatedCollection};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -38,6 +38,12 @@ pub struct PropagatedShape {
     pub confidence: f64,
     /// Per part present in the collection.
     pub parts: Vec<PropagatedPart>,
+    /// What the map step did (only with `--map-step`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub map_step: Option<MapStepReport>,
+    /// The name of the source the map step mapped this shape to.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub map_source: Option<String>,
 }
 
 /// `summary.json` of `coseg propagate`: no timings, so reruns give the same bytes.
@@ -63,6 +69,9 @@ pub struct PropagationSummary {
     pub options: PropagateOptions,
     /// The graph's options.
     pub graph: GraphOptions,
+    /// The map step's options (only with `--map-step`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub map_step: Option<MapStepOptions>,
 }
 
 impl PropagationSummary {
@@ -92,6 +101,12 @@ impl PropagationSummary {
                             confidence: p.part_confidence[i][r],
                         })
                         .collect(),
+                    map_step: c.map_steps.get(i).cloned().flatten(),
+                    map_source: c
+                        .map_steps
+                        .get(i)
+                        .and_then(|r| r.as_ref())
+                        .map(|r| c.graph.node(r.source).name.clone()),
                 }
             })
             .collect();
@@ -133,6 +148,7 @@ impl PropagationSummary {
                 .collect(),
             options: options.clone(),
             graph: *graph,
+            map_step: c.map_step.clone(),
         }
     }
 }

@@ -1,6 +1,9 @@
 //! [`propagate_collection`]: a folder of meshes and its label files in one call.
 
-use super::{PropagateError, PropagateOptions, Propagation, propagate_labels};
+use super::{
+    MapStepOptions, MapStepReport, MapStepShape, PropagateError, PropagateOptions, Propagation,
+    map_step, propagate_labels,
+};
 use crate::cache::CacheOutcome;
 use crate::graph::{GraphOptions, ShapeGraph, ShapeNode, SkippedFile, load_collection};
 use crate::labels::{
@@ -27,6 +30,10 @@ pub struct PropagateCollectionOptions {
     pub cache_dir: Option<PathBuf>,
     /// Optional part names, a JSON `{label: name}` file.
     pub part_names: Option<PathBuf>,
+    /// The map step ([`map_step`]) after the propagation, for near-isometric collections
+    /// (default `None`: off). Each unlabelled shape is mapped to its nearest source (smallest
+    /// graph summary distance); the shapes' spectra come from the full cache entries.
+    pub map_step: Option<MapStepOptions>,
 }
 
 /// An annotation used as a source.
@@ -62,6 +69,11 @@ pub struct PropagatedCollection {
     /// Where each shape's per-shape data came from (graph order): a cache hit, a miss, or a
     /// recomputed stale entry.
     pub outcomes: Vec<CacheOutcome>,
+    /// What the map step did on each shape (graph order; `None` for the sources, for shapes it
+    /// could not run on, and everywhere when it is off).
+    pub map_steps: Vec<Option<MapStepReport>>,
+    /// The map step's options when it ran.
+    pub map_step: Option<MapStepOptions>,
     /// Warnings for the user.
     pub warnings: Vec<String>,
 }
@@ -144,8 +156,26 @@ pub fn propagate_collection(
         Some(p) => read_part_names(p)?,
         None => PartNames::new(),
     };
-    let solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, options)?;
+    let mut solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, options)?;
     warnings.extend(solved.warnings);
+    let map_steps = match &options.map_step {
+        Some(ms) => {
+            ms.validate()
+                .map_err(|e| PropagateError::BadOption(e.to_string()))?;
+            let (reports, w) = run_map_step(
+                &loaded.meshes,
+                &solved.graph,
+                &annotations,
+                &mut solved.propagation,
+                &options.pipeline,
+                &cache,
+                ms,
+            );
+            warnings.extend(w);
+            reports
+        }
+        None => vec![None; loaded.meshes.len()],
+    };
     Ok(PropagatedCollection {
         paths: loaded.paths,
         meshes: loaded.meshes,
@@ -156,8 +186,113 @@ pub fn propagate_collection(
         part_names,
         skipped: loaded.skipped,
         outcomes: loaded.outcomes,
+        map_steps,
+        map_step: options.map_step.clone(),
         warnings,
     })
+}
+
+/// One shape's map step: its labels and report, or why it could not run.
+type MapStepOutcome = Result<(Vec<i32>, MapStepReport), String>;
+
+/// The map step of [`propagate_collection`] on every unlabelled shape, in parallel (one
+/// target's full per-shape data in memory per thread, the sources' shared). A shape whose
+/// data or map fails keeps its propagated labels with a warning: the step is optional.
+/// Relabelled shapes get their part shares recomputed; confidences are the propagation's.
+fn run_map_step(
+    meshes: &[TriMesh],
+    graph: &ShapeGraph,
+    annotations: &[Option<Vec<i32>>],
+    propagation: &mut Propagation,
+    pipeline: &ShapePipelineOptions,
+    cache: &Path,
+    options: &MapStepOptions,
+) -> (Vec<Option<MapStepReport>>, Vec<String>) {
+    let n = meshes.len();
+    let name = |i: usize| graph.node(i).name.clone();
+    let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
+    let source_data: Vec<_> = sources
+        .par_iter()
+        .map(|&s| crate::pipeline::load_or_compute(&meshes[s], pipeline, cache))
+        .collect();
+    let mut warnings = Vec::new();
+    let mut loaded = Vec::with_capacity(sources.len());
+    for (&s, d) in sources.iter().zip(source_data) {
+        match d {
+            Ok(d) => loaded.push(d.data),
+            Err(e) => {
+                warnings.push(format!("map step off: source {}: {e}", name(s)));
+                return (vec![None; n], warnings);
+            }
+        }
+    }
+    let results: Vec<Option<MapStepOutcome>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if annotations[i].is_some() {
+                return None;
+            }
+            // The nearest source by summary distance (ties: the first).
+            let k = (0..sources.len())
+                .min_by(|&a, &b| {
+                    graph
+                        .summary_distance(i, sources[a])
+                        .total_cmp(&graph.summary_distance(i, sources[b]))
+                })
+                .expect("at least one source");
+            let s = sources[k];
+            let run = || -> MapStepOutcome {
+                let data = crate::pipeline::load_or_compute(&meshes[i], pipeline, cache)
+                    .map_err(|e| e.to_string())?
+                    .data;
+                let source = MapStepShape {
+                    spectrum: &loaded[k].spectrum,
+                    positions: meshes[s].positions(),
+                    labels: annotations[s].as_deref().unwrap_or_default(),
+                    descriptors: None,
+                };
+                let target = MapStepShape {
+                    spectrum: &data.spectrum,
+                    positions: meshes[i].positions(),
+                    labels: &propagation.labels[i],
+                    descriptors: None,
+                };
+                map_step(&source, &target, &graph.node(i).areas, s, options)
+                    .map_err(|e| e.to_string())
+            };
+            Some(run())
+        })
+        .collect();
+    let mut reports = vec![None; n];
+    for (i, r) in results.into_iter().enumerate() {
+        match r {
+            None => {}
+            Some(Err(e)) => warnings.push(format!("shape {}: map step skipped: {e}", name(i))),
+            Some(Ok((labels, report))) => {
+                if report.applied {
+                    let areas = &graph.node(i).areas;
+                    for (r, &part) in propagation.parts.iter().enumerate() {
+                        propagation.part_shares[i][r] = labels
+                            .iter()
+                            .zip(areas)
+                            .filter(|(l, _)| **l == part)
+                            .map(|(_, a)| a)
+                            .sum();
+                    }
+                    propagation.labels[i] = labels;
+                } else {
+                    warnings.push(format!(
+                        "shape {}: map step rejected (its labels agree with the propagation on {:.1} % of the area, below {:.1} %)",
+                        name(i),
+                        100.0 * report.agreement,
+                        100.0 * options.min_agreement
+                    ));
+                }
+                reports[i] = Some(report);
+            }
+        }
+    }
+    (reports, warnings)
 }
 
 /// Result of [`propagate_loaded`]: the collection stage of [`propagate_collection`].

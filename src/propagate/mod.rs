@@ -10,8 +10,12 @@
 //!   one call, as `coseg propagate` runs it; [`crate::output::write_propagation`] writes its files.
 //!   [`propagate_loaded`] is its collection stage alone, for shapes already in memory (the
 //!   Python package's `coseg.propagate` on arrays).
+//! - [`map_step`]: for near-isometric collections, a target's labels carried point by point
+//!   from its nearest source through a point map, kept when they agree with the propagation
+//!   ([`PropagateCollectionOptions::map_step`], `coseg propagate --map-step`).
 
 mod collection;
+mod map_step;
 mod options;
 mod part_scores;
 mod solve;
@@ -20,6 +24,7 @@ pub use collection::{
     PropagateCollectionOptions, PropagatedCollection, PropagatedShapes, SourceFile,
     propagate_collection, propagate_loaded,
 };
+pub use map_step::{MapStepOptions, MapStepReport, MapStepShape, map_step};
 pub use options::PropagateOptions;
 pub use part_scores::{GEOMETRIC_FLOOR, PartScore};
 pub use solve::{Propagation, UpdateStats, propagate_labels};
