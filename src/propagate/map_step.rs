@@ -16,7 +16,7 @@ pub struct MapStepOptions {
     /// correspondence (typically an intrinsic symmetry flip), not a sharper one, and is
     /// rejected. Measured on TOSCA and FAUST (docs/PROPAGATION.md, "Map step"): kept maps
     /// agree on 81–96 %, rejected ones (flips, other people's bodies) on 61–78 %; the
-    /// agreement does not separate every harmful map (two of 77 kept lowered their target).
+    /// agreement does not separate every harmful map (three of 77 kept lowered their target).
     pub min_agreement: f64,
 }
 
