@@ -430,56 +430,41 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             };
             let t = Instant::now();
             let r = if map_step {
-                // The library's map step from the source (shape 0) to every target, as
+                // The library's map step on the propagation from the source (shape 0), as
                 // `coseg propagate --map-step` runs it.
                 let n = set.names.len();
                 let annv: Vec<Option<Vec<i32>>> =
                     (0..n).map(|i| (i == 0).then(|| truth.clone())).collect();
-                let p = propagate_labels(&set.graph, set.smoothers.as_deref(), &annv, &options)?;
-                let src = coseg::pipeline::load_or_compute(&set.meshes[0], &pipeline, &cache)?.data;
-                let o = coseg::propagate::MapStepOptions::default();
-                let out: Vec<(usize, f64, f64, f64, bool)> = (1..n)
-                    .into_par_iter()
-                    .map(|i| {
-                        let data =
-                            coseg::pipeline::load_or_compute(&set.meshes[i], &pipeline, &cache)
-                                .unwrap()
-                                .data;
-                        let a = coseg::propagate::MapStepShape {
-                            spectrum: &src.spectrum,
-                            positions: set.meshes[0].positions(),
-                            labels: &truth,
-                            descriptors: None,
-                        };
-                        let b = coseg::propagate::MapStepShape {
-                            spectrum: &data.spectrum,
-                            positions: set.meshes[i].positions(),
-                            labels: &p.labels[i],
-                            descriptors: None,
-                        };
-                        let (l, rep) =
-                            coseg::propagate::map_step(&a, &b, &set.graph.node(i).areas, 0, &o)
-                                .unwrap();
-                        (
-                            i,
-                            score(i, &p.labels[i]),
-                            score(i, &l),
-                            rep.agreement,
-                            rep.applied,
-                        )
-                    })
-                    .collect();
-                for &(i, before, after, agree, applied) in &out {
+                let mut p =
+                    propagate_labels(&set.graph, set.smoothers.as_deref(), &annv, &options)?;
+                let before = p.labels.clone();
+                let (reports, warnings) = coseg::propagate::map_step_collection(
+                    &set.meshes,
+                    &set.graph,
+                    &annv,
+                    &mut p,
+                    &pipeline,
+                    &cache,
+                    &coseg::propagate::MapStepOptions::default(),
+                );
+                for w in warnings.iter().filter(|w| !w.contains("rejected")) {
+                    eprintln!("warning: {w}");
+                }
+                let mut out = Vec::new();
+                for (i, rep) in reports.iter().enumerate() {
+                    let Some(rep) = rep else { continue };
+                    let after = score(i, &p.labels[i]);
                     println!(
                         "  {}: {:.1} % -> {:.1} % (agreement {:.1} %, {})",
                         set.names[i],
-                        100.0 * before,
+                        100.0 * score(i, &before[i]),
                         100.0 * after,
-                        100.0 * agree,
-                        if applied { "kept" } else { "rejected" }
+                        100.0 * rep.agreement,
+                        if rep.applied { "kept" } else { "rejected" }
                     );
+                    out.push((i, after));
                 }
-                out.iter().map(|&(i, _, a, _, _)| (i, a)).collect()
+                out
             } else {
                 run(&set, &[0], &ann, &score, &options)?
             };

@@ -473,7 +473,8 @@ fn blob_parts(mesh: &coseg::mesh::TriMesh) -> (Vec<i32>, Vec<i32>) {
 #[test]
 fn map_step_corrects_a_misplaced_boundary_on_an_isometric_copy() {
     use common::features::{blob, permutation, permute_mesh};
-    use coseg::propagate::{MapStepOptions, MapStepShape, map_step};
+    use coseg::maps::MapShape;
+    use coseg::propagate::{MapStepOptions, map_step};
     use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
     let mesh = blob(3);
     let n = mesh.vertex_count();
@@ -487,13 +488,13 @@ fn map_step_corrects_a_misplaced_boundary_on_an_isometric_copy() {
         laplace_beltrami_spectrum(&mesh, &so).unwrap(),
         laplace_beltrami_spectrum(&copy, &so).unwrap(),
     );
-    let source = MapStepShape {
+    let source = MapShape {
         spectrum: &sa,
         positions: mesh.positions(),
         labels: &truth,
         descriptors: None,
     };
-    let target = MapStepShape {
+    let target = MapShape {
         spectrum: &sb,
         positions: copy.positions(),
         labels: &rough,
@@ -532,9 +533,10 @@ fn map_step_corrects_a_misplaced_boundary_on_an_isometric_copy() {
 }
 
 /// `coseg propagate --map-step` end to end, the real binary on a folder of the blob and two
-/// permuted copies (exact isometries) with a rough annotation-free start: every copy's map is
-/// kept and recorded in `summary.json` with its source, the labels reach ≥ 99 % of the truth,
-/// and without the flag the summary has no map-step field (the default output is unchanged).
+/// permuted copies (exact isometries; the propagation alone already labels them well, so this
+/// checks the plumbing, and the test above the map itself): every copy's map is kept and
+/// recorded in `summary.json` with its source, the labels reach ≥ 99 % of the truth, and
+/// without the flag the summary has no map-step field (the default output is unchanged).
 #[test]
 fn coseg_propagate_map_step_on_isometric_copies() {
     use common::features::{blob, permutation, permute_mesh};

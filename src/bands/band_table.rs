@@ -79,6 +79,5 @@ pub fn band_table(
             }
         }
     }
-    debug_assert_eq!(table.vertices, d);
     Ok(table)
 }

@@ -1,14 +1,15 @@
 //! [`propagate_collection`]: a folder of meshes and its label files in one call.
 
 use super::{
-    MapStepOptions, MapStepReport, MapStepShape, PropagateError, PropagateOptions, Propagation,
-    map_step, propagate_labels,
+    MapStepOptions, MapStepReport, PropagateError, PropagateOptions, Propagation, map_step,
+    propagate_labels,
 };
 use crate::cache::CacheOutcome;
 use crate::graph::{GraphOptions, ShapeGraph, ShapeNode, SkippedFile, load_collection};
 use crate::labels::{
     LabelError, LabelKind, PartNames, match_label_files, read_part_names, read_shape_labels,
 };
+use crate::maps::MapShape;
 use crate::mesh::TriMesh;
 use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
@@ -162,7 +163,7 @@ pub fn propagate_collection(
         Some(ms) => {
             ms.validate()
                 .map_err(|e| PropagateError::BadOption(e.to_string()))?;
-            let (reports, w) = run_map_step(
+            let (reports, w) = map_step_collection(
                 &loaded.meshes,
                 &solved.graph,
                 &annotations,
@@ -195,11 +196,33 @@ pub fn propagate_collection(
 /// One shape's map step: its labels and report, or why it could not run.
 type MapStepOutcome = Result<(Vec<i32>, MapStepReport), String>;
 
-/// The map step of [`propagate_collection`] on every unlabelled shape, in parallel (one
-/// target's full per-shape data in memory per thread, the sources' shared). A shape whose
-/// data or map fails keeps its propagated labels with a warning: the step is optional.
-/// Relabelled shapes get their part shares recomputed; confidences are the propagation's.
-fn run_map_step(
+/// The map step ([`map_step`]) of [`propagate_collection`] on every unlabelled shape of
+/// `propagation`, each mapped to its nearest source (smallest graph summary distance; ties:
+/// the first), in parallel (one target's full per-shape data in memory per thread, the
+/// sources' shared). The shapes' spectra come from `cache` under `pipeline`
+/// ([`crate::pipeline::load_or_compute`]), so `pipeline` must be the one the graph was built
+/// with. A shape whose data or map fails keeps its propagated labels with a warning: the step
+/// is optional. A kept map replaces the shape's labels and its part shares and confidences are
+/// recomputed from them (per-vertex confidences stay the propagation's margins).
+///
+/// Inputs: `meshes` and `annotations` (`#shapes`, graph order; `Some` per-vertex labels on the
+/// sources), the `graph` and `propagation` they were solved on. Output: per shape the report
+/// (`None` for sources and skipped shapes) and warnings for the user.
+///
+/// ```no_run
+/// use coseg::propagate::{map_step_collection, propagate_collection, MapStepOptions,
+///     PropagateCollectionOptions};
+/// use std::path::{Path, PathBuf};
+/// let options = PropagateCollectionOptions::default();
+/// let mut out = propagate_collection(Path::new("poses"), &[PathBuf::from("poses/a.labels.txt")],
+///     &options).unwrap();
+/// let mut annotations = vec![None; out.meshes.len()];
+/// annotations[out.sources[0].shape] = Some(out.propagation.labels[out.sources[0].shape].clone());
+/// let cache = std::env::temp_dir().join("coseg-cache");
+/// let (reports, warnings) = map_step_collection(&out.meshes, &out.graph, &annotations,
+///     &mut out.propagation, &options.pipeline, &cache, &MapStepOptions::default());
+/// ```
+pub fn map_step_collection(
     meshes: &[TriMesh],
     graph: &ShapeGraph,
     annotations: &[Option<Vec<i32>>],
@@ -245,13 +268,13 @@ fn run_map_step(
                 let data = crate::pipeline::load_or_compute(&meshes[i], pipeline, cache)
                     .map_err(|e| e.to_string())?
                     .data;
-                let source = MapStepShape {
+                let source = MapShape {
                     spectrum: &loaded[k].spectrum,
                     positions: meshes[s].positions(),
                     labels: annotations[s].as_deref().unwrap_or_default(),
                     descriptors: None,
                 };
-                let target = MapStepShape {
+                let target = MapShape {
                     spectrum: &data.spectrum,
                     positions: meshes[i].positions(),
                     labels: &propagation.labels[i],
@@ -270,16 +293,7 @@ fn run_map_step(
             Some(Err(e)) => warnings.push(format!("shape {}: map step skipped: {e}", name(i))),
             Some(Ok((labels, report))) => {
                 if report.applied {
-                    let areas = &graph.node(i).areas;
-                    for (r, &part) in propagation.parts.iter().enumerate() {
-                        propagation.part_shares[i][r] = labels
-                            .iter()
-                            .zip(areas)
-                            .filter(|(l, _)| **l == part)
-                            .map(|(_, a)| a)
-                            .sum();
-                    }
-                    propagation.labels[i] = labels;
+                    propagation.set_labels(graph, i, labels);
                 } else {
                     warnings.push(format!(
                         "shape {}: map step rejected (its labels agree with the propagation on {:.1} % of the area, below {:.1} %)",

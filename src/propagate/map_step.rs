@@ -54,9 +54,6 @@ pub struct MapStepReport {
     pub applied: bool,
 }
 
-/// One shape of [`map_step`]: its spectrum, positions and part labels (`-1` = none).
-pub type MapStepShape<'a> = MapShape<'a>;
-
 /// Re-labels a target through a point map to a labelled source, the near-isometric
 /// refinement of a propagation (the propagation's analogue of `coseg pair`'s map step).
 ///
@@ -81,7 +78,8 @@ pub type MapStepShape<'a> = MapShape<'a>;
 /// ```
 /// use coseg::mesh::TriMesh;
 /// use coseg::spectral::{laplace_beltrami_spectrum, SpectrumOptions};
-/// use coseg::propagate::{map_step, MapStepOptions, MapStepShape};
+/// use coseg::maps::MapShape;
+/// use coseg::propagate::{map_step, MapStepOptions};
 /// // A strip of 8 × 2 squares; the source's parts are its left and right halves, the
 /// // target (the same strip) has a rough propagated labelling with one vertex wrong.
 /// let (nx, ny) = (9u32, 3u32);
@@ -99,8 +97,8 @@ pub type MapStepShape<'a> = MapShape<'a>;
 /// let truth: Vec<i32> = (0..nx * ny).map(|i| i32::from(i % nx >= 4)).collect();
 /// let mut rough = truth.clone();
 /// rough[4] = 0;
-/// let source = MapStepShape { spectrum: &spectrum, positions: &pos, labels: &truth, descriptors: None };
-/// let target = MapStepShape { spectrum: &spectrum, positions: &pos, labels: &rough, descriptors: None };
+/// let source = MapShape { spectrum: &spectrum, positions: &pos, labels: &truth, descriptors: None };
+/// let target = MapShape { spectrum: &spectrum, positions: &pos, labels: &rough, descriptors: None };
 /// let mut o = MapStepOptions::default();
 /// (o.point_map.zoomout.initial_size, o.point_map.zoomout.final_size, o.point_map.zoomout.step) = (4, 12, 4);
 /// let (labels, report) = map_step(&source, &target, &vec![1.0; pos.len()], 0, &o).unwrap();
@@ -108,8 +106,8 @@ pub type MapStepShape<'a> = MapShape<'a>;
 /// assert_eq!(labels, truth);
 /// ```
 pub fn map_step(
-    source: &MapStepShape<'_>,
-    target: &MapStepShape<'_>,
+    source: &MapShape<'_>,
+    target: &MapShape<'_>,
     target_areas: &[f64],
     source_index: usize,
     options: &MapStepOptions,

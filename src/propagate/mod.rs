@@ -12,7 +12,8 @@
 //!   Python package's `coseg.propagate` on arrays).
 //! - [`map_step`]: for near-isometric collections, a target's labels carried point by point
 //!   from its nearest source through a point map, kept when they agree with the propagation
-//!   ([`PropagateCollectionOptions::map_step`], `coseg propagate --map-step`).
+//!   ([`PropagateCollectionOptions::map_step`], `coseg propagate --map-step`);
+//!   [`map_step_collection`] runs it on every unlabelled shape of a propagation.
 
 mod collection;
 mod map_step;
@@ -22,9 +23,9 @@ mod solve;
 
 pub use collection::{
     PropagateCollectionOptions, PropagatedCollection, PropagatedShapes, SourceFile,
-    propagate_collection, propagate_loaded,
+    map_step_collection, propagate_collection, propagate_loaded,
 };
-pub use map_step::{MapStepOptions, MapStepReport, MapStepShape, map_step};
+pub use map_step::{MapStepOptions, MapStepReport, map_step};
 pub use options::PropagateOptions;
 pub use part_scores::{GEOMETRIC_FLOOR, PartScore};
 pub use solve::{Propagation, UpdateStats, propagate_labels};

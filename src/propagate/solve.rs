@@ -633,6 +633,23 @@ impl Propagation {
         Ok((labels, margins))
     }
 
+    /// Replaces the labels of unlabelled shape `i` (label values, `-1` = none; a value that is
+    /// not a part becomes `-1`) and recomputes its part shares and confidences, so that the
+    /// next [`Propagation::update`] continues from them. Used by the map step.
+    pub(crate) fn set_labels(&mut self, graph: &ShapeGraph, i: usize, labels: Vec<i32>) {
+        self.state[i] = labels
+            .iter()
+            .map(|l| {
+                self.parts
+                    .iter()
+                    .position(|p| p == l)
+                    .map_or(-1, |r| r as i32)
+            })
+            .collect();
+        self.labels[i] = labels;
+        self.update_stats(graph, i);
+    }
+
     fn update_stats(&mut self, graph: &ShapeGraph, i: usize) {
         let areas = &graph.node(i).areas;
         let np = self.parts.len();
