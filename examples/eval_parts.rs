@@ -240,7 +240,7 @@ fn main() -> Res<()> {
             )
         } else {
             let (p, c) = family_scores(&loaded, seg, &folder, detail)?;
-            format!("purity {:.1} % coverage {:.1} %", 100.0 * p, 100.0 * c)
+            format!("purity {:.2} % coverage {:.2} %", 100.0 * p, 100.0 * c)
         };
         println!(
             "{mode:>12}: {score}  confidence {:.3}  parts {} (median sizes % {}){extra}  {secs:.2} s",

@@ -1035,8 +1035,9 @@ pub struct PartsReport {
     /// 10 % of its area (`None` without meshes).
     pub pieces: Option<Vec<usize>>,
     /// Final region ids with two or more such pieces on most shapes: left/right (or other)
-    /// copies of a part that intrinsic features cannot tell apart. An extrinsic feature family
-    /// would split them; none is used by this version.
+    /// copies of a part that intrinsic features cannot tell apart. With an extrinsic feature
+    /// family (`--features spectral,extrinsic --up AXIS`, an aligned collection) heights along
+    /// tilted directions tell the copies apart, and they can become parts of their own.
     pub mirror_candidates: Vec<usize>,
 }
 

@@ -35,7 +35,9 @@ pub use cycle_consistency::{CycleConsistency, cycle_consistency};
 pub use load_collection::{
     LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
 };
-pub use refine_cosegmentation::{RefineSizes, refine_cosegmentation, refine_cosegmentation_sized};
+pub use refine_cosegmentation::{
+    MIN_KEPT_SHARE, RefineSizes, refine_cosegmentation, refine_cosegmentation_sized,
+};
 pub use segment_collection::{
     SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection, start_score,
 };
