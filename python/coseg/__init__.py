@@ -22,10 +22,13 @@ Per-shape options (every function that computes per-shape data takes them):
   distances, in the frame ``up``), ``"sdf"`` (shape diameter), ``"user:DIR"`` (``DIR`` holds
   ``<stem>.npy`` or ``.csv`` per shape; arrays are matched by their name). docs/FEATURES.md.
 - ``up`` (default ``"y"``): frame of the extrinsic family, the collection's up axis
-  (``"x"``, ``"-z"``, ...) or ``"pca"``; ``directions`` (default 100): its height directions.
+  (``"x"``, ``"-z"``, ...) or ``"pca"``; ``directions`` (default 100): its height directions;
+  ``normals`` (default 0): its normal columns ``|n . u|``, banded by value and weighted as a
+  family of their own (``normals=16`` with ``families="spectral,extrinsic"`` is the
+  recommended configuration for aligned collections, docs/FEATURES.md).
 - ``family_weights`` (default 1 each): a family's total share of the affinity, a dict
-  ``{"extrinsic": 2}`` or a string ``"extrinsic=2,sdf=0.5"``; used by :func:`segment` (as
-  ``coseg segment``; the pair and propagation stages weight every column equally).
+  ``{"extrinsic": 2}`` or a string ``"extrinsic=2,sdf=0.5"``; used by :func:`pair`,
+  :func:`segment` and :func:`propagate` as by the CLI's commands.
 """
 
 from __future__ import annotations
@@ -86,6 +89,7 @@ PIPELINE_OPTIONS = (
     "families",
     "up",
     "directions",
+    "normals",
     "family_weights",
 )
 MESH_SUFFIXES = (".obj", ".off", ".ply")
@@ -185,6 +189,7 @@ def _pipeline(
     up: str = _D["up"],
     directions: int = _D["directions"],
     family_weights: Any = None,
+    normals: int = _D["normals"],
     **counts: Any,
 ) -> Dict[str, Any]:
     """The native module's per-shape options from the public keywords: ``families`` becomes
@@ -201,6 +206,7 @@ def _pipeline(
     counts["features"] = ",".join((["spectral"] if spectral else []) + rest)
     counts["up"] = str(up)
     counts["directions"] = directions
+    counts["normals"] = normals
     counts["family_weights"] = _weights(family_weights)
     return counts
 
@@ -246,16 +252,26 @@ def features(
     curvature: int = _D["curvature"],
     up: str = _D["up"],
     directions: int = _D["directions"],
+    normals: int = _D["normals"],
 ) -> Tuple[List[str], np.ndarray]:
     """Per-vertex descriptors: ``(names, matrix)`` with ``matrix`` ``n x N`` float64 and
     ``names[j]`` naming column ``j`` (``hks_000``, ..., ``wks_...``, ``curv_...``, then
     ``ext_...``, ``sdf_...``, ``user_...`` of the other families). ``families``: see the
     module's docstring (default ``"spectral"``; ``("wks",)`` alone, ``"spectral,extrinsic"``,
-    ...); the spectral counts are per part (defaults 100 each, from 200 eigenpairs); ``up``
-    and ``directions`` set the extrinsic family (as ``coseg features --up --directions``)."""
+    ...); the spectral counts are per part (defaults 100 each, from 200 eigenpairs); ``up``,
+    ``directions`` and ``normals`` set the extrinsic family (as ``coseg features --up
+    --directions --normals``)."""
     V, F = _as_mesh(V, F)
     opts = _pipeline(
-        families, up, directions, None, eigenpairs=eigenpairs, hks=hks, wks=wks, curvature=curvature
+        families,
+        up,
+        directions,
+        None,
+        normals,
+        eigenpairs=eigenpairs,
+        hks=hks,
+        wks=wks,
+        curvature=curvature,
     )
     return _coseg.features(V, F, opts)
 
@@ -273,17 +289,19 @@ def band_table(
     area_bands: bool = _D["area_bands"],
     up: str = _D["up"],
     directions: int = _D["directions"],
+    normals: int = _D["normals"],
 ) -> np.ndarray:
     """The band table: ``n x N`` uint8, entry ``(v, j)`` the band (``0..bands``) of vertex
     ``v`` in feature ``j`` (columns as :func:`features`, same ``families``, ``up``,
-    ``directions``). Default 20 bands of equal vertex count (``area_bands=True``: equal
-    area)."""
+    ``directions``, ``normals``). Default 20 bands of equal vertex count (``area_bands=True``:
+    equal area); the normal columns are cut by value into equal intervals of [0, 1]."""
     V, F = _as_mesh(V, F)
     opts = _pipeline(
         families,
         up,
         directions,
         None,
+        normals,
         eigenpairs=eigenpairs,
         hks=hks,
         wks=wks,
@@ -296,8 +314,8 @@ def band_table(
 
 _PIPELINE_DOC = """Per-shape options (part of the cache key; defaults as the CLI's): ``eigenpairs`` (200),
     ``hks``, ``wks``, ``curvature`` (100 each), ``bands`` (20), ``area_bands`` (False),
-    ``families`` (``"spectral"``), ``up`` (``"y"``), ``directions`` (100), ``family_weights``
-    (1 each); see the module's docstring."""
+    ``families`` (``"spectral"``), ``up`` (``"y"``), ``directions`` (100), ``normals`` (0),
+    ``family_weights`` (1 each); see the module's docstring."""
 
 
 def _pipe(
@@ -311,12 +329,14 @@ def _pipe(
     up: str,
     directions: int,
     family_weights: Any,
+    normals: int,
 ) -> Dict[str, Any]:
     return _pipeline(
         families,
         up,
         directions,
         family_weights,
+        normals,
         eigenpairs=eigenpairs,
         hks=hks,
         wks=wks,
@@ -363,6 +383,7 @@ def pair(
     up: str = _D["up"],
     directions: int = _D["directions"],
     family_weights: Any = None,
+    normals: int = _D["normals"],
 ) -> Dict[str, Any]:
     """Stable region correspondences between two shapes (``coseg pair``).
 
@@ -410,7 +431,7 @@ def pair(
         map_smoothing_time=map_smoothing_time,
         cache_dir=_path(cache_dir),
         out=_path(out),
-        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights),
+        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights, normals),
     )
     return _coseg.pair([(va, fa), (vb, fb)], list(names), opts, [xa, xb])
 
@@ -421,7 +442,10 @@ def segment(
     names: Optional[Sequence[str]] = None,
     cache_dir: Optional[Union[str, os.PathLike]] = None,
     out: Optional[Union[str, os.PathLike]] = None,
-    regions: int = _D["regions"],
+    regions: Optional[int] = None,
+    parts: Optional[Union[str, int]] = None,
+    starts: int = _D["starts"],
+    refine_sizes: str = _D["refine_sizes"],
     area_fraction: Optional[float] = _D["area_fraction"],
     seed: Optional[int] = _D["segment_seed"],
     complete_limit: int = _D["complete_limit"],
@@ -438,6 +462,7 @@ def segment(
     up: str = _D["up"],
     directions: int = _D["directions"],
     family_weights: Any = None,
+    normals: int = _D["normals"],
 ) -> Dict[str, Any]:
     """Consistent co-segmentation of a collection (``coseg segment``).
 
@@ -451,10 +476,19 @@ def segment(
     CLI's region files).
 
     Options (defaults as ``coseg segment``): ``regions`` (6) regions per shape, the last the
-    leftovers; ``area_fraction`` (None: 1 / regions) of each region; ``seed`` (None: start
-    from the most distinctive vertex); ``complete_limit`` (12): collections up to this size
-    use a complete shape graph, larger ones ``neighbours`` (6) nearest neighbours;
-    ``refine_rounds`` (boundary refinement sweeps, 0 = none) and ``smoothing_time``.
+    leftovers; ``parts`` (None): parts of their own size instead of equal areas (Algorithm 3
+    across the collection, docs/PARTS.md), ``"auto"`` for as many as are stable and
+    consistent or an integer N to cut the tree of parts at N, ``regions`` then being the
+    upper bound (default 8) and ``summary["parts"]`` the thresholds, sizes, tree and mirror
+    candidates; ``starts`` (1): co-segment from this many starts and keep the one of highest
+    mean confidence (equal-area mode); ``refine_sizes`` (``"free"``): ``"keep"`` or
+    ``"keep:TOL"`` keeps each part's area within a factor 1 + TOL (default 0.5) of its
+    area before refinement (meant for ``parts``); ``area_fraction`` (None: 1 / regions) of
+    each region; ``seed`` (None: start from the most distinctive vertex); ``complete_limit``
+    (12): collections up to this size use a complete shape graph, larger ones ``neighbours``
+    (6) nearest neighbours; ``refine_rounds`` (boundary refinement sweeps, 0 = none) and
+    ``smoothing_time``. Recommended for aligned collections: ``families="spectral,extrinsic",
+    up=..., normals=16``.
     ``cache_dir``: per-shape cache (for a folder, default ``<out>/.cache``, as the CLI, or
     ``<folder>/.cache`` without ``out``; for a list, none unless given). Fill it on a
     cluster with :func:`coseg.dask.precompute`.
@@ -463,6 +497,9 @@ def segment(
     """
     opts = dict(
         regions=regions,
+        parts=None if parts is None else str(parts),
+        starts=starts,
+        refine_sizes=refine_sizes,
         area_fraction=area_fraction,
         seed=seed,
         complete_limit=complete_limit,
@@ -471,7 +508,7 @@ def segment(
         smoothing_time=smoothing_time,
         cache_dir=_path(cache_dir),
         out=_path(out),
-        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights),
+        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights, normals),
     )
     if isinstance(shapes, (str, os.PathLike)):
         if names is not None:
@@ -513,6 +550,9 @@ def propagate(
     network_weight: float = _D["network_weight"],
     similarity_power: float = _D["similarity_power"],
     size_prior: float = _D["size_prior"],
+    area_weighted: bool = _D["area_weighted"],
+    map_step: bool = False,
+    map_agreement: float = _D["map_agreement"],
     eigenpairs: int = _D["eigenpairs"],
     hks: int = _D["hks"],
     wks: int = _D["wks"],
@@ -523,6 +563,7 @@ def propagate(
     up: str = _D["up"],
     directions: int = _D["directions"],
     family_weights: Any = None,
+    normals: int = _D["normals"],
 ) -> Dict[str, Any]:
     """Part labels from a few annotated shapes to a whole collection (``coseg propagate``).
 
@@ -554,7 +595,13 @@ def propagate(
     ``similarity_power`` (0 = all sources alike; 4 helps on collections that mix kinds) how
     much more a source like the target counts when several vote;
     ``size_prior`` (0.25, in [0, 1]) how strongly part sizes follow the sources' area
-    shares; ``complete_limit`` (12) and ``neighbours`` (6) of the shape graph.
+    shares; ``area_weighted`` (False) weighs the parts' band histograms by vertex area;
+    ``map_step`` (False; a folder only, it reads the spectra from the cache) re-labels each
+    unlabelled shape through a point map from its nearest source, kept where it agrees with
+    the propagation on at least ``map_agreement`` (0.8) of the area (near-isometric
+    collections; docs/PROPAGATION.md, "Map step"); ``complete_limit`` (12) and
+    ``neighbours`` (6) of the shape graph. Recommended for aligned collections:
+    ``families="spectral,extrinsic", up=..., normals=16, area_weighted=True``.
     ``part_names``: a JSON ``{label: name}`` file or a dict ``{label: name}`` (for a list of
     shapes), carried into the summary. ``cache_dir``: per-shape cache (default for a folder
     ``<out>/.cache`` as the CLI, else the library's, in the system's temporary folder; for a
@@ -575,9 +622,12 @@ def propagate(
         network_weight=network_weight,
         similarity_power=similarity_power,
         size_prior=size_prior,
+        area_weighted=area_weighted,
+        map_step=map_step,
+        map_agreement=map_agreement,
         cache_dir=_path(cache_dir),
         out=_path(out),
-        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights),
+        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights, normals),
     )
     if isinstance(part_names, (str, os.PathLike)):
         opts["part_names"] = os.fspath(part_names)
@@ -637,6 +687,7 @@ def _pipeline_opts(options: Dict[str, Any]) -> Dict[str, Any]:
         families=o.pop("families", _D["features"]),
         up=o.pop("up", _D["up"]),
         directions=o.pop("directions", _D["directions"]),
+        normals=o.pop("normals", _D["normals"]),
         family_weights=o.pop("family_weights", None),
     )
     return _pipeline(**fam, **o)

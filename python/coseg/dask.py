@@ -95,7 +95,7 @@ def precompute(
     ``paths``: a folder (its mesh files, as :func:`mesh_files`) or an iterable of mesh
     files. ``options``: the per-shape options (``eigenpairs``, ``hks``, ``wks``,
     ``curvature``, ``bands``, ``area_bands``, ``families``, ``up``, ``directions``,
-    ``family_weights``; library defaults), which must match those of the later ``segment``
+    ``normals``, ``family_weights``; library defaults), which must match those of the later ``segment``
     or ``propagate`` call, since they are part of the key. (``families`` with ``user:DIR``
     cannot run as a pure task: the task sees bytes, not the file name its features are
     matched by.) ``ship="bytes"`` sends each

@@ -28,5 +28,6 @@ def precompute(
     families: Union[str, Sequence[str]] = ...,
     up: str = ...,
     directions: int = ...,
+    normals: int = ...,
     family_weights: Union[None, str, Mapping[str, float]] = ...,
 ) -> PrecomputeReport: ...

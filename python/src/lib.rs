@@ -627,7 +627,8 @@ fn segment<'py>(
     let result = py
         .detach(|| segment_collection(nodes, &meshes, &seg_opts))
         .or_raise()?;
-    let summary = CollectionSummary::new(&result, &files, &seg_opts, skipped.clone());
+    let mut summary = CollectionSummary::new(&result, &files, &seg_opts, skipped.clone());
+    summary.parts = result.parts_report(&meshes);
     let seg = &result.segmentation;
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
     let written = match &out_dir {
@@ -779,8 +780,14 @@ fn propagate<'py>(
     let names_file: Option<PathBuf> = o.take("part_names")?;
     let names_map: Option<PartNames> = o.take("part_names_map")?;
     (opts.graph, opts.propagate) = o.propagate()?;
+    opts.map_step = o.map_step()?;
     o.finish()?;
     let (result, outcomes) = if let Ok(list) = shapes.cast::<PyList>() {
+        if opts.map_step.is_some() {
+            return Err(input_err(
+                "map_step: the map step needs the shapes' spectra from a folder's cache; give a folder (shapes=PATH), not shapes in memory",
+            ));
+        }
         let list = shapes_from(list, names, files)?;
         let inputs = label_inputs(&labels)?;
         let pipe = opts.pipeline.clone();

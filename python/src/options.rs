@@ -7,10 +7,12 @@ use coseg::features::{
     ExtrinsicOptions, FamilyWeights, FeatureError, parse_alignment, parse_families,
     parse_family_weights,
 };
-use coseg::graph::{CosegmentOptions, GraphOptions, SegmentCollectionOptions};
+use coseg::graph::{
+    CosegmentOptions, GraphError, GraphOptions, PartsRequest, RefineSizes, SegmentCollectionOptions,
+};
 use coseg::maps::{MapGuidedOptions, MapOverrides, MapPreset, MapStep, ZoomOutOptions};
 use coseg::pipeline::ShapePipelineOptions;
-use coseg::propagate::PropagateOptions;
+use coseg::propagate::{MapStepOptions, PropagateOptions};
 use coseg::stable::{
     Algorithm, AreaReference, Init, RefineOptions, SegmentPairOptions, StableRegionsOptions,
     TSearch, Threshold,
@@ -63,21 +65,27 @@ impl<'py> Opts<'py> {
 
     /// `eigenpairs`, `hks`, `wks`, `curvature`, `bands`, `area_bands`, and the feature
     /// families: `features` (`spectral,extrinsic,sdf,user:DIR`), `up`, `directions`,
-    /// `family_weights` (`NAME=W,...`), as the CLI's `--features`, `--up`, `--directions`,
-    /// `--family-weights` (same parsers, same defaults).
+    /// `normals`, `family_weights` (`NAME=W,...`), as the CLI's `--features`, `--up`,
+    /// `--directions`, `--normals`, `--family-weights` (same parsers, same defaults).
     pub fn pipeline(&mut self) -> PyResult<ShapePipelineOptions> {
         let mut p = ShapePipelineOptions::default();
         let features: Option<String> = self.take("features")?;
         let up: Option<String> = self.take("up")?;
         let directions: Option<usize> = self.take("directions")?;
+        let normals: Option<usize> = self.take("normals")?;
         let weights: Option<String> = self.take("family_weights")?;
         let lib = |e: FeatureError| super::lib_err(&e);
         let alignment = parse_alignment(up.as_deref().unwrap_or(DEFAULT_UP)).map_err(lib)?;
         let (spectral, mut families) =
             parse_families(features.as_deref().unwrap_or(DEFAULT_FEATURES), alignment)
                 .map_err(lib)?;
-        if let (Some(e), Some(n)) = (families.extrinsic.as_mut(), directions) {
-            e.directions = n;
+        if let Some(e) = families.extrinsic.as_mut() {
+            if let Some(n) = directions {
+                e.directions = n;
+            }
+            if let Some(n) = normals {
+                e.normal_directions = n;
+            }
         }
         parse_family_weights(weights.as_deref().unwrap_or(""), &mut families.weights)
             .map_err(lib)?;
@@ -133,7 +141,24 @@ impl<'py> Opts<'py> {
         if let Some(v) = self.take("size_prior")? {
             p.size_prior = v;
         }
+        if let Some(v) = self.take("area_weighted")? {
+            p.area_weighted = v;
+        }
         Ok((graph, p))
+    }
+
+    /// The propagation's map step, as `coseg propagate --map-step --map-agreement` sets it:
+    /// `map_step` (bool) and `map_agreement`.
+    pub fn map_step(&mut self) -> PyResult<Option<MapStepOptions>> {
+        let on = self.take::<bool>("map_step")?.unwrap_or(false);
+        let agreement: Option<f64> = self.take("map_agreement")?;
+        Ok(on.then(|| {
+            let mut m = MapStepOptions::default();
+            if let Some(a) = agreement {
+                m.min_agreement = a;
+            }
+            m
+        }))
     }
 
     /// The collection stage's options, as `coseg segment` sets them.
@@ -141,9 +166,6 @@ impl<'py> Opts<'py> {
         let d = SegmentCollectionOptions::default();
         let mut graph = GraphOptions::default();
         let mut cos = CosegmentOptions::default();
-        if let Some(v) = self.take("regions")? {
-            cos.regions = v;
-        }
         cos.area_fraction = self.take("area_fraction")?;
         cos.seed = self.take("seed")?;
         if let Some(v) = self.take("complete_limit")? {
@@ -158,18 +180,33 @@ impl<'py> Opts<'py> {
             .unwrap_or(SegmentCollectionOptions::DEFAULT_REFINE);
         let rounds = self.take("refine_rounds")?.unwrap_or(base.max_rounds);
         let time = self.take("smoothing_time")?.unwrap_or(base.smoothing_time);
-        Ok({
-            let mut o2 = d;
-            o2.graph = graph;
-            o2.cosegment = cos;
-            o2.refine = (rounds > 0).then_some({
-                let mut opts = RefineOptions::default();
-                opts.max_rounds = rounds;
-                opts.smoothing_time = time;
-                opts
-            });
-            o2
-        })
+        let upper_bound: Option<usize> = self.take("regions")?;
+        let parts: Option<String> = self.take("parts")?;
+        let starts: Option<usize> = self.take("starts")?;
+        let sizes: Option<String> = self.take("refine_sizes")?;
+        let lib = |e: GraphError| super::lib_err(&e);
+        let mut o2 = d;
+        if let Some(v) = upper_bound {
+            cos.regions = v;
+        }
+        o2.graph = graph;
+        o2.cosegment = cos;
+        o2.refine = (rounds > 0).then_some({
+            let mut opts = RefineOptions::default();
+            opts.max_rounds = rounds;
+            opts.smoothing_time = time;
+            opts
+        });
+        if let Some(n) = starts {
+            o2.starts = n;
+        }
+        if let Some(r) = sizes {
+            o2.refine_sizes = r.parse::<RefineSizes>().map_err(lib)?;
+        }
+        if let Some(p) = parts {
+            o2.request_parts(p.parse::<PartsRequest>().map_err(lib)?, upper_bound);
+        }
+        Ok(o2)
     }
 
     /// The pair stage's options, as `coseg pair` sets them.
@@ -288,6 +325,7 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("features", DEFAULT_FEATURES)?;
     d.set_item("up", DEFAULT_UP)?;
     d.set_item("directions", ExtrinsicOptions::default().directions)?;
+    d.set_item("normals", ExtrinsicOptions::default().normal_directions)?;
     let w = FamilyWeights::default();
     let weights = PyDict::new(py);
     weights.set_item("spectral", w.spectral)?;
@@ -308,6 +346,10 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("neighbours", s.graph.neighbours)?;
     d.set_item("segment_refine_rounds", refine.max_rounds)?;
     d.set_item("segment_smoothing_time", refine.smoothing_time)?;
+    d.set_item("starts", s.starts)?;
+    d.set_item("refine_sizes", "free")?;
+    let a = coseg::graph::AdaptiveOptions::default();
+    d.set_item("max_parts", a.max_parts)?;
     let r = StableRegionsOptions::default();
     d.set_item(
         "algorithm",
@@ -345,6 +387,8 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("network_weight", po.network_weight)?;
     d.set_item("similarity_power", po.similarity_power)?;
     d.set_item("size_prior", po.size_prior)?;
+    d.set_item("area_weighted", po.area_weighted)?;
+    d.set_item("map_agreement", MapStepOptions::default().min_agreement)?;
     d.set_item("map_preset", "auto")?;
     d.set_item("map_size", ZoomOutOptions::default().final_size)?;
     d.set_item(

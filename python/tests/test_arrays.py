@@ -86,8 +86,14 @@ def test_defaults_are_the_library_defaults():
     d = coseg.DEFAULTS
     assert d["eigenpairs"] == 200 and d["bands"] == 20 and d["regions"] == 6
     sig = inspect.signature(coseg.segment).parameters
-    assert sig["regions"].default == d["regions"]
+    # None: 6 regions, or with parts= an upper bound of 8 parts (as the CLI's --regions).
+    assert sig["regions"].default is None and d["max_parts"] == 8
     assert sig["eigenpairs"].default == d["eigenpairs"]
+    assert sig["starts"].default == d["starts"] == 1 and sig["refine_sizes"].default == "free"
+    assert sig["normals"].default == d["normals"] == 0
+    p = inspect.signature(coseg.propagate).parameters
+    assert p["area_weighted"].default == d["area_weighted"] is False
+    assert p["map_agreement"].default == d["map_agreement"] == 0.8
     assert inspect.signature(coseg.pair).parameters["pairs"].default == d["pairs"]
 
 

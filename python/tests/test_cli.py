@@ -108,3 +108,50 @@ def test_feature_families_match_the_cli(coseg_bin, chairs, tmp_path):
     assert all(n.startswith("ext_") for n in names[36:])
     names2, X2 = coseg.features(V, F, families="extrinsic", directions=8)
     assert names2 == names[36:] and np.array_equal(X2, X[:, 36:])
+
+
+def test_parts_starts_and_normals_match_the_cli(coseg_bin, chairs, tmp_path):
+    """parts=, refine_sizes=, starts=, normals= are the CLI's --parts, --refine-sizes, --starts,
+    --normals: same region files and summary (with its parts report) byte for byte."""
+    fam = ["--features", "spectral,extrinsic", "--up", "y", "--directions", "8", "--normals", "4"]
+    kw = dict(families="spectral,extrinsic", up="y", directions=8, normals=4, **SMALL)
+    runs = [
+        (["--regions", "5", "--parts", "3", "--refine-sizes", "keep:0.3"],
+         dict(regions=5, parts=3, refine_sizes="keep:0.3")),
+        (["--parts", "auto"], dict(parts="auto")),
+        (["--regions", "3", "--starts", "2"], dict(regions=3, starts=2)),
+    ]
+    for k, (flags, opts) in enumerate(runs):
+        cli_out, py_out = tmp_path / f"cli{k}", tmp_path / f"py{k}"
+        subprocess.run(
+            [coseg_bin, "segment", str(chairs), "-o", str(cli_out), *cli_flags(), *fam, *flags,
+             "--no-pictures"],
+            check=True,
+            capture_output=True,
+        )
+        r = coseg.segment(chairs, out=py_out, **opts, **kw)
+        assert_same_outputs(cli_out, py_out)
+        if "parts" in opts:
+            assert r["summary"]["parts"]["region_leaves"]
+            if opts["parts"] == 3:
+                assert len(r["summary"]["parts"]["region_leaves"]) == 3
+                assert r["summary"]["options"]["refine_sizes"] == {"rule": "keep", "tolerance": 0.3}
+        else:
+            assert "parts" not in r["summary"]
+            assert len(r["summary"]["starts"]["scores"]) == 2
+    # The normal columns are in the table, banded by value.
+    V, F = coseg.read_mesh(sorted(chairs.glob("*.obj"))[0])
+    names, X = coseg.features(V, F, families="extrinsic", directions=8, normals=4)
+    assert names[-4:] == [f"ext_nrm_{i:03d}" for i in range(4)]
+    T = coseg.band_table(V, F, families="extrinsic", directions=8, normals=4, bands=10)
+    assert np.array_equal(T[:, -4:], np.minimum(np.floor(X[:, -4:] * 10), 9).astype(np.uint8))
+
+
+def test_bad_parts_options_raise(chairs):
+    for bad in (dict(parts=0), dict(parts="many"), dict(refine_sizes="keep:-1"), dict(refine_sizes="tight")):
+        try:
+            coseg.segment(chairs, **bad, **SMALL)
+        except coseg.InputError as e:
+            assert "expected" in str(e)
+        else:
+            raise AssertionError(f"{bad} accepted")

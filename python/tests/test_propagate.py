@@ -165,7 +165,9 @@ def test_propagate_releases_the_gil():
     done = {}
 
     def work():
-        done["r"] = coseg.propagate(shapes, [truth] + [None] * 5, **SMALL)
+        # 100 eigenpairs (not SMALL's 30): long enough on a fast host for the check below to
+        # mean something (with SMALL it once took 0.42 s, under the 0.5 s the check needs).
+        done["r"] = coseg.propagate(shapes, [truth] + [None] * 5, **dict(SMALL, eigenpairs=100))
 
     t = threading.Thread(target=work)
     t0 = time.perf_counter()
@@ -179,3 +181,31 @@ def test_propagate_releases_the_gil():
     assert "r" in done
     # Holding the GIL, the loop above would stall for the whole computation.
     assert total > 0.5 and gap < 0.5 * total, (gap, total)
+
+
+def test_map_step_and_area_weights_match_the_cli(coseg_bin, tmp_path):
+    """map_step=, map_agreement=, area_weighted=, normals= are the CLI's --map-step,
+    --map-agreement, --area-weighted, --normals: the same files byte for byte, the map step's
+    decisions in the summary."""
+    cli = tmp_path / "cli"
+    subprocess.run(
+        [coseg_bin, "propagate", str(GOBLETS), "--labels", str(SOURCE), "-o", str(cli), "--no-pictures",
+         "--quiet", *cli_flags(), "--map-step", "--map-agreement", "0.5", "--area-weighted", "true",
+         "--features", "spectral,extrinsic", "--normals", "4", "--directions", "8"],
+        check=True,
+        capture_output=True,
+    )
+    out = tmp_path / "py"
+    kw = dict(families="spectral,extrinsic", normals=4, directions=8, area_weighted=True, **SMALL)
+    r = coseg.propagate(GOBLETS, SOURCE, out=out, map_step=True, map_agreement=0.5, **kw)
+    for f in output_files(cli):
+        assert (cli / f).read_bytes() == (out / f).read_bytes(), f
+    assert r["summary"]["map_step"]["min_agreement"] == 0.5
+    assert sum("map_step" in s for s in r["summary"]["shapes"]) == len(NAMES) - 1
+    # Without the map step the summary has no trace of it.
+    r0 = coseg.propagate(GOBLETS, SOURCE, cache_dir=tmp_path / "c0", **kw)
+    assert "map_step" not in r0["summary"]
+    # Shapes in memory have no cached spectra: a clear error, before any work.
+    shapes = [coseg.read_mesh(p) for p in MESHES]
+    with pytest.raises(InputError, match="map_step"):
+        coseg.propagate(shapes, [SOURCE] + [None] * (len(shapes) - 1), map_step=True, **kw)

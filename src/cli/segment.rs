@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{
-    AdaptiveOptions, CosegmentOptions, GraphOptions, LoadedCollection, PartsReport, RefineSizes,
+    CosegmentOptions, GraphError, GraphOptions, LoadedCollection, PartsRequest, RefineSizes,
     SegmentCollectionOptions, SegmentedCollection, load_collection, segment_collection,
 };
 use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
@@ -37,7 +37,7 @@ pub struct SegmentArgs {
     /// = as many as are stable and consistent, `N` = cut the tree of parts at N. Without it,
     /// `--regions` equal-area regions.
     #[arg(long, value_parser = parse_parts)]
-    parts: Option<PartsArg>,
+    parts: Option<PartsRequest>,
     /// Area of each region as a fraction of its shape (default: 1 / regions).
     #[arg(long)]
     area_fraction: Option<f64>,
@@ -66,7 +66,7 @@ pub struct SegmentArgs {
     /// `--parts`, whose sizes come from the data) or `keep:TOL` (within a factor 1 + TOL).
     /// See docs/PARTS.md.
     #[arg(long, value_parser = parse_refine_sizes)]
-    refine_sizes: Option<RefineSizesArg>,
+    refine_sizes: Option<RefineSizes>,
     /// Heat-smoothing time of the refinement (unit-area surface; 0 = no smoothing).
     #[arg(long, default_value_t = SegmentCollectionOptions::DEFAULT_REFINE.smoothing_time)]
     smoothing_time: f64,
@@ -75,39 +75,13 @@ pub struct SegmentArgs {
 }
 
 /// `--refine-sizes free|keep[:TOL]`.
-#[derive(Debug, Clone, Copy)]
-enum RefineSizesArg {
-    Free,
-    Keep(Option<f64>),
-}
-
-fn parse_refine_sizes(s: &str) -> Result<RefineSizesArg, String> {
-    let bad = || format!("{s:?}: expected `free`, `keep` or `keep:TOL` (TOL ≥ 0)");
-    match s {
-        "free" => Ok(RefineSizesArg::Free),
-        "keep" => Ok(RefineSizesArg::Keep(None)),
-        _ => match s.strip_prefix("keep:").map(str::parse::<f64>) {
-            Some(Ok(t)) if t.is_finite() && t >= 0.0 => Ok(RefineSizesArg::Keep(Some(t))),
-            _ => Err(bad()),
-        },
-    }
+fn parse_refine_sizes(s: &str) -> Result<RefineSizes, String> {
+    s.parse().map_err(|e: GraphError| e.to_string())
 }
 
 /// `--parts auto|N`.
-#[derive(Debug, Clone, Copy)]
-enum PartsArg {
-    Auto,
-    Count(usize),
-}
-
-fn parse_parts(s: &str) -> Result<PartsArg, String> {
-    match s {
-        "auto" => Ok(PartsArg::Auto),
-        _ => match s.parse::<usize>() {
-            Ok(k) if k >= 1 => Ok(PartsArg::Count(k)),
-            _ => Err(format!("{s:?}: expected `auto` or a number of parts ≥ 1")),
-        },
-    }
+fn parse_parts(s: &str) -> Result<PartsRequest, String> {
+    s.parse().map_err(|e: GraphError| e.to_string())
 }
 
 pub fn run(args: SegmentArgs) -> Result<ExitCode> {
@@ -165,8 +139,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         .collect();
     let skipped = loaded.skipped.iter().map(SkippedInput::from).collect();
     let mut summary = CollectionSummary::new(&result, &files, &options, skipped);
-    if let Some(a) = &result.adaptive {
-        let report = PartsReport::new(a, seg, &loaded.meshes);
+    if let (Some(a), Some(report)) = (&result.adaptive, result.parts_report(&loaded.meshes)) {
         if !super::quiet() {
             println!(
                 "parts: {} finest ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}",
@@ -237,25 +210,10 @@ fn collection_options(
     });
     o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
     o2.starts = args.starts;
-    let tolerance = AdaptiveOptions::default().size_tolerance;
-    o2.refine_sizes = match args.refine_sizes {
-        None | Some(RefineSizesArg::Free) => RefineSizes::Free,
-        Some(RefineSizesArg::Keep(t)) => RefineSizes::Keep {
-            tolerance: t.unwrap_or(tolerance),
-        },
-    };
-    o2.parts = args.parts.map(|p| {
-        let mut o = AdaptiveOptions::default();
-        if let PartsArg::Count(k) = p {
-            o.parts = Some(k);
-            o.max_parts = o.max_parts.max(k);
-        }
-        if let Some(r) = args.regions {
-            o.max_parts = r;
-        }
-        o.seed = args.seed;
-        o
-    });
+    o2.refine_sizes = args.refine_sizes.unwrap_or_default();
+    if let Some(p) = args.parts {
+        o2.request_parts(p, args.regions);
+    }
     o2
 }
 

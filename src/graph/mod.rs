@@ -39,7 +39,8 @@ pub use refine_cosegmentation::{
     MIN_KEPT_SHARE, RefineSizes, refine_cosegmentation, refine_cosegmentation_sized,
 };
 pub use segment_collection::{
-    SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection, start_score,
+    PartsRequest, SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection,
+    start_score,
 };
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
 pub use stable_cycle::{

@@ -83,6 +83,40 @@ pub enum RefineSizes {
     },
 }
 
+impl std::str::FromStr for RefineSizes {
+    type Err = GraphError;
+
+    /// `free`, `keep` (tolerance [`AdaptiveOptions::size_tolerance`](super::AdaptiveOptions),
+    /// the sizes' own tolerance) or `keep:TOL` (`TOL` ≥ 0), as `coseg segment --refine-sizes`.
+    ///
+    /// ```
+    /// use coseg::graph::RefineSizes;
+    /// assert_eq!("free".parse::<RefineSizes>().unwrap(), RefineSizes::Free);
+    /// assert_eq!("keep:0.25".parse::<RefineSizes>().unwrap(), RefineSizes::Keep { tolerance: 0.25 });
+    /// assert_eq!("keep".parse::<RefineSizes>().unwrap(), RefineSizes::Keep { tolerance: 0.5 });
+    /// assert!("keep:-1".parse::<RefineSizes>().is_err());
+    /// ```
+    fn from_str(s: &str) -> Result<Self, GraphError> {
+        let bad = || {
+            GraphError::BadOption(format!(
+                "{s:?}: expected `free`, `keep` or `keep:TOL` (TOL ≥ 0)"
+            ))
+        };
+        match s {
+            "free" => Ok(Self::Free),
+            "keep" => Ok(Self::Keep {
+                tolerance: super::AdaptiveOptions::default().size_tolerance,
+            }),
+            _ => match s.strip_prefix("keep:").map(str::parse::<f64>) {
+                Some(Ok(tolerance)) if tolerance.is_finite() && tolerance >= 0.0 => {
+                    Ok(Self::Keep { tolerance })
+                }
+                _ => Err(bad()),
+            },
+        }
+    }
+}
+
 /// [`refine_cosegmentation`] with a size rule ([`RefineSizes`]); `RefineSizes::Free` is
 /// [`refine_cosegmentation`] bit for bit.
 pub fn refine_cosegmentation_sized(

@@ -4,7 +4,7 @@
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    RefineSizes, adaptive_cosegment, cosegment, refine_cosegmentation_sized,
+    PartsReport, RefineSizes, adaptive_cosegment, cosegment, refine_cosegmentation_sized,
 };
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -71,6 +71,67 @@ impl SegmentCollectionOptions {
     };
 }
 
+/// How many parts of their own size to ask for (`coseg segment --parts auto|N`).
+///
+/// ```
+/// use coseg::graph::PartsRequest;
+/// assert_eq!("auto".parse::<PartsRequest>().unwrap(), PartsRequest::Auto);
+/// assert_eq!("4".parse::<PartsRequest>().unwrap(), PartsRequest::Count(4));
+/// assert!("0".parse::<PartsRequest>().is_err());
+/// ```
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PartsRequest {
+    /// As many as are stable, consistent and separated (the finest consistent parts).
+    Auto,
+    /// This many (≥ 1): the tree of parts is cut there.
+    Count(usize),
+}
+
+impl std::str::FromStr for PartsRequest {
+    type Err = GraphError;
+
+    fn from_str(s: &str) -> Result<Self, GraphError> {
+        match s {
+            "auto" => Ok(Self::Auto),
+            _ => match s.parse::<usize>() {
+                Ok(k) if k >= 1 => Ok(Self::Count(k)),
+                _ => Err(GraphError::BadOption(format!(
+                    "{s:?}: expected `auto` or a number of parts ≥ 1"
+                ))),
+            },
+        }
+    }
+}
+
+impl SegmentCollectionOptions {
+    /// Switches to parts of their own size ([`Self::parts`]): [`AdaptiveOptions::default`]
+    /// with `request`'s number of parts, at most `upper_bound` parts when given (`coseg
+    /// segment --regions` with `--parts`; default [`AdaptiveOptions::max_parts`], raised to a
+    /// requested count above it), and each tuple started as [`CosegmentOptions::seed`] says.
+    ///
+    /// ```
+    /// use coseg::graph::{PartsRequest, SegmentCollectionOptions};
+    /// let mut o = SegmentCollectionOptions::default();
+    /// o.request_parts(PartsRequest::Count(10), None);
+    /// let p = o.parts.unwrap();
+    /// assert_eq!((p.parts, p.max_parts), (Some(10), 10));
+    /// o.request_parts(PartsRequest::Auto, Some(5));
+    /// assert_eq!(o.parts.unwrap().max_parts, 5);
+    /// ```
+    pub fn request_parts(&mut self, request: PartsRequest, upper_bound: Option<usize>) {
+        let mut o = AdaptiveOptions::default();
+        if let PartsRequest::Count(k) = request {
+            o.parts = Some(k);
+            o.max_parts = o.max_parts.max(k);
+        }
+        if let Some(r) = upper_bound {
+            o.max_parts = r;
+        }
+        o.seed = self.cosegment.seed;
+        self.parts = Some(o);
+    }
+}
+
 impl Default for SegmentCollectionOptions {
     fn default() -> Self {
         Self {
@@ -113,6 +174,17 @@ pub struct SegmentedCollection {
     pub start: usize,
     /// The selection score of every start: the mean confidence of its final tuples.
     pub start_scores: Vec<f64>,
+}
+
+impl SegmentedCollection {
+    /// What `summary.json` records of the adaptive run (`coseg segment --parts`): the
+    /// [`PartsReport`] of [`Self::adaptive`] for the final segmentation, its pieces counted on
+    /// `meshes` (graph order; empty: no piece counts). `None` without `--parts`.
+    pub fn parts_report(&self, meshes: &[TriMesh]) -> Option<PartsReport> {
+        self.adaptive
+            .as_ref()
+            .map(|a| PartsReport::new(a, &self.segmentation, meshes))
+    }
 }
 
 /// The score by which [`segment_collection`] chooses among starts: the mean confidence of the
