@@ -262,18 +262,8 @@ def features(
     ``directions`` and ``normals`` set the extrinsic family (as ``coseg features --up
     --directions --normals``)."""
     V, F = _as_mesh(V, F)
-    opts = _pipeline(
-        families,
-        up,
-        directions,
-        None,
-        normals,
-        eigenpairs=eigenpairs,
-        hks=hks,
-        wks=wks,
-        curvature=curvature,
-    )
-    return _coseg.features(V, F, opts)
+    counts = dict(eigenpairs=eigenpairs, hks=hks, wks=wks, curvature=curvature)
+    return _coseg.features(V, F, _pipeline(families, up, directions, None, normals, **counts))
 
 
 def band_table(
@@ -296,20 +286,8 @@ def band_table(
     ``directions``, ``normals``). Default 20 bands of equal vertex count (``area_bands=True``:
     equal area); the normal columns are cut by value into equal intervals of [0, 1]."""
     V, F = _as_mesh(V, F)
-    opts = _pipeline(
-        families,
-        up,
-        directions,
-        None,
-        normals,
-        eigenpairs=eigenpairs,
-        hks=hks,
-        wks=wks,
-        curvature=curvature,
-        bands=bands,
-        area_bands=area_bands,
-    )
-    return _coseg.band_table(V, F, opts)
+    counts = dict(eigenpairs=eigenpairs, hks=hks, wks=wks, curvature=curvature, bands=bands, area_bands=area_bands)
+    return _coseg.band_table(V, F, _pipeline(families, up, directions, None, normals, **counts))
 
 
 _PIPELINE_DOC = """Per-shape options (part of the cache key; defaults as the CLI's): ``eigenpairs`` (200),
