@@ -141,7 +141,11 @@ fn family_scores(
 
 fn options(mode: &str, refine_rounds: usize, starts: usize) -> Res<SegmentCollectionOptions> {
     let mut o = SegmentCollectionOptions::default();
-    o.starts = starts;
+    // Several starts are for the equal-area mode only (segment_collection refuses them with
+    // --parts).
+    if mode.starts_with("fixed:") {
+        o.starts = starts;
+    }
     if let Some(r) = o.refine.as_mut() {
         r.max_rounds = refine_rounds;
     }

@@ -184,6 +184,27 @@ fn refine_sizes_is_recorded_and_checked() {
     }
 }
 
+/// Regression: `--parts auto --starts 3` ran one start and said nothing; several starts are
+/// for the equal-area mode, so the combination is now an error that names `starts`.
+#[test]
+fn regression_starts_with_parts_was_silently_ignored() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 2, 2);
+    let out = dir.path().join("out");
+    let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
+    args.extend(FAST);
+    args.extend(["--parts", "auto", "--starts", "3"]);
+    let run = coseg(&args);
+    assert_ne!(run.status.code(), Some(0));
+    let err = text(&run.stderr);
+    assert!(
+        err.contains("starts = 3") && err.contains("--parts"),
+        "{err}"
+    );
+}
+
 #[test]
 fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
     let dir = tempfile::tempdir().unwrap();

@@ -459,7 +459,7 @@ def segment(
     consistent or an integer N to cut the tree of parts at N, ``regions`` then being the
     upper bound (default 8) and ``summary["parts"]`` the thresholds, sizes, tree and mirror
     candidates; ``starts`` (1): co-segment from this many starts and keep the one of highest
-    mean confidence (equal-area mode); ``refine_sizes`` (``"free"``): ``"keep"`` or
+    mean confidence (equal-area mode only: with ``parts`` it raises :class:`InputError`); ``refine_sizes`` (``"free"``): ``"keep"`` or
     ``"keep:TOL"`` keeps each part's area within a factor 1 + TOL (default 0.5) of its
     area before refinement (meant for ``parts``); ``area_fraction`` (None: 1 / regions) of
     each region; ``seed`` (None: start from the most distinctive vertex); ``complete_limit``

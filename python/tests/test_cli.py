@@ -148,10 +148,17 @@ def test_parts_starts_and_normals_match_the_cli(coseg_bin, chairs, tmp_path):
 
 
 def test_bad_parts_options_raise(chairs):
-    for bad in (dict(parts=0), dict(parts="many"), dict(refine_sizes="keep:-1"), dict(refine_sizes="tight")):
+    cases = [
+        (dict(parts=0), "expected"),
+        (dict(parts="many"), "expected"),
+        (dict(refine_sizes="keep:-1"), "expected"),
+        (dict(refine_sizes="tight"), "expected"),
+        (dict(parts="auto", starts=3), "starts = 3"),  # several starts: equal-area mode only
+    ]
+    for bad, message in cases:
         try:
             coseg.segment(chairs, **bad, **SMALL)
         except coseg.InputError as e:
-            assert "expected" in str(e)
+            assert message in str(e), (bad, str(e))
         else:
             raise AssertionError(f"{bad} accepted")

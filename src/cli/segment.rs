@@ -46,7 +46,8 @@ pub struct SegmentArgs {
     #[arg(long)]
     seed: Option<u64>,
     /// Co-segment from this many starts (the default start, then seeded ones) and keep the one
-    /// with the highest mean region confidence. See docs/PARTS.md.
+    /// with the highest mean region confidence; equal-area mode only (an error with
+    /// `--parts`). See docs/PARTS.md.
     #[arg(long, default_value_t = SegmentCollectionOptions::default().starts)]
     starts: usize,
     /// Collections up to this size use a complete shape graph; larger ones a nearest-neighbour

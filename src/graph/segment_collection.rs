@@ -39,7 +39,8 @@ pub struct SegmentCollectionOptions {
     /// and some collections have several (measured on COSEG chairs with spectral + extrinsic
     /// features: 63 % or 85 % of the area right depending on the start, the better one with the
     /// higher confidence; docs/PARTS.md). Costs `starts` co-segmentations and refinements (the
-    /// smoothers are factored once). Not used with [`Self::parts`].
+    /// smoothers are factored once). Only for the equal-area mode: with [`Self::parts`] more
+    /// than one start is an error ([`GraphError::BadOption`]).
     #[serde(skip_serializing_if = "is_one")]
     pub starts: usize,
     /// How the refinement treats region sizes (default [`RefineSizes::Free`], the classic
@@ -256,6 +257,12 @@ pub fn segment_collection(
     if options.starts == 0 {
         return Err(GraphError::BadOption("starts must be at least 1".into()));
     }
+    if options.starts > 1 && options.parts.is_some() {
+        return Err(GraphError::BadOption(format!(
+            "starts = {}: several starts apply to the equal-area co-segmentation, not to parts of their own size (--parts)",
+            options.starts
+        )));
+    }
     let refine = options.refine.as_ref().filter(|r| r.max_rounds > 0);
     let t = Instant::now();
     let smoothers = match refine {
@@ -274,14 +281,9 @@ pub fn segment_collection(
         _ => None,
     };
     times.smoothers = t.elapsed();
-    let starts = if options.parts.is_some() {
-        1
-    } else {
-        options.starts
-    };
     let mut best: Option<(f64, usize, Cosegmentation, Option<AdaptiveCosegmentation>)> = None;
-    let mut start_scores = Vec::with_capacity(starts);
-    for start in 0..starts {
+    let mut start_scores = Vec::with_capacity(options.starts);
+    for start in 0..options.starts {
         let t = Instant::now();
         let (mut segmentation, adaptive) = match &options.parts {
             None => {
