@@ -151,20 +151,12 @@ pub fn refine_cosegmentation_sized(
     let neighbours: Vec<Vec<usize>> = (0..n)
         .map(|i| graph.neighbours(i).into_iter().map(|(j, _)| j).collect())
         .collect();
-    // Size-aware rule: per-shape area fractions before refinement, and the log factors.
-    let targets: Option<(f64, Vec<Vec<f64>>)> = match sizes {
-        RefineSizes::Free => None,
-        RefineSizes::Keep { tolerance } => Some((
-            tolerance,
-            (0..n)
-                .map(|i| coseg.tuples.iter().map(|t| t.area_fractions[i]).collect())
-                .collect(),
-        )),
-    };
-    let mut theta: Vec<Vec<f64>> = vec![vec![0.0; regions]; n];
+    // Per-shape area fractions before refinement (the size-aware rule's targets and the free
+    // rule's floors), and the log factors of the size-constrained assignment.
     let start: Vec<Vec<f64>> = (0..n)
         .map(|i| coseg.tuples.iter().map(|t| t.area_fractions[i]).collect())
         .collect();
+    let mut theta: Vec<Vec<f64>> = vec![vec![0.0; regions]; n];
     let mut clock = 1usize;
     let mut changed_at = vec![clock; n];
     let mut updated_at = vec![0usize; n];
@@ -182,8 +174,8 @@ pub fn refine_cosegmentation_sized(
                 .filter(|_| options.smoothing_time > 0.0)
                 .map(|s| &s[i]);
             let areas = &graph.node(i).areas;
-            let (new, margin) = match &targets {
-                None => {
+            let (new, margin) = match sizes {
+                RefineSizes::Free => {
                     let (l, m) = assign_regions(&mut total, regions, smoother).map_err(stable)?;
                     let shares = region_shares(&l, areas, regions);
                     if (0..regions).any(|r| shares[r] < MIN_KEPT_SHARE * start[i][r]) {
@@ -198,7 +190,7 @@ pub fn refine_cosegmentation_sized(
                         (l, m)
                     }
                 }
-                Some((tolerance, t)) => {
+                RefineSizes::Keep { tolerance } => {
                     if let Some(s) = smoother {
                         s.smooth(&mut total, regions)
                             .map_err(|e| GraphError::BadOption(e.to_string()))?;
@@ -206,8 +198,8 @@ pub fn refine_cosegmentation_sized(
                     assign_sized(
                         &total,
                         areas,
-                        &t[i],
-                        Band::Tolerance(*tolerance),
+                        &start[i],
+                        Band::Tolerance(tolerance),
                         &mut theta[i],
                     )
                 }
@@ -233,9 +225,9 @@ pub fn refine_cosegmentation_sized(
 /// `target[r]` = region `r`'s area fraction before refinement, `band` the allowed areas
 /// around it, `theta[r]` the log factors (updated in place, warm start). Each vertex takes
 /// `argmax_r ln s_r(q) + θ_r`; passes over the regions set, for each region whose area is
-/// outside its band, its `θ_r` exactly to the value
-/// that puts the area on the nearest bound with the others held (a coordinate step of the
-/// dual of the size-constrained assignment), until every area is inside or after
+/// outside its band, its `θ_r` exactly to the value that puts the area on the nearest bound
+/// with the others held (a coordinate step of the dual of the size-constrained assignment),
+/// until every area is inside or after
 /// [`SIZE_PASSES`] passes. Returns the labels and the margins `(best − second) / best` of the
 /// scaled scores.
 fn assign_sized(
