@@ -121,18 +121,25 @@ fn broken_file_is_reported_and_skipped_with_exit_3_and_strict_fails() {
     assert!(!strict_out.join("summary.json").exists());
 }
 
+/// `coseg segment -q --no-pictures --parts auto` with `extra` flags on two small shapes made
+/// in `dir`; the run and its output folder.
+fn segment_parts_auto(dir: &Path, extra: &[&str]) -> (Output, std::path::PathBuf) {
+    let input = dir.join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 2, 2);
+    let out = dir.join("out");
+    let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
+    args.extend(FAST);
+    args.extend(["--parts", "auto"]);
+    args.extend(extra);
+    (coseg(&args), out)
+}
+
 /// `--parts auto` printed its "parts: …" line under `--quiet`.
 #[test]
 fn regression_quiet_parts_auto_prints_nothing() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 2, 2);
-    let out = dir.path().join("out");
-    let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
-    args.extend(FAST);
-    args.extend(["--parts", "auto"]);
-    let run = coseg(&args);
+    let (run, out) = segment_parts_auto(dir.path(), &[]);
     assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
     assert!(run.stdout.is_empty(), "{}", text(&run.stdout));
     assert!(run.stderr.is_empty(), "{}", text(&run.stderr));
@@ -189,14 +196,7 @@ fn refine_sizes_is_recorded_and_checked() {
 #[test]
 fn regression_starts_with_parts_was_silently_ignored() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 2, 2);
-    let out = dir.path().join("out");
-    let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
-    args.extend(FAST);
-    args.extend(["--parts", "auto", "--starts", "3"]);
-    let run = coseg(&args);
+    let (run, _) = segment_parts_auto(dir.path(), &["--starts", "3"]);
     assert_ne!(run.status.code(), Some(0));
     let err = text(&run.stderr);
     assert!(
