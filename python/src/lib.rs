@@ -629,6 +629,8 @@ fn segment<'py>(
         .or_raise()?;
     let mut summary = CollectionSummary::new(&result, &files, &seg_opts, skipped.clone());
     summary.parts = result.parts_report(&meshes);
+    let mut warnings = warnings;
+    warnings.extend(summary.parts.as_ref().and_then(|p| p.warning()));
     let seg = &result.segmentation;
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
     let written = match &out_dir {

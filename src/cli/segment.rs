@@ -150,6 +150,9 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
                 report.mirror_candidates
             );
         }
+        if let Some(w) = report.warning() {
+            super::warn(w);
+        }
         summary.parts = Some(report);
     }
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();

@@ -169,6 +169,37 @@ pub enum StopReason {
     },
 }
 
+impl std::fmt::Display for StopReason {
+    /// What stopped the extraction, with the rejected tuple's value (the levels are
+    /// [`AdaptiveOptions`]'s).
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::MaxParts => write!(f, "the upper bound on the number of parts was reached"),
+            Self::Exhausted => write!(f, "a shape had no area left to split"),
+            Self::NoStableTuple => write!(f, "no threshold left a stable tuple on every shape"),
+            Self::LowConfidence { confidence } => {
+                write!(
+                    f,
+                    "the next tuple's confidence, {confidence:.3}, was below the level"
+                )
+            }
+            Self::LowCycleConsistency { cycle_consistency } => write!(
+                f,
+                "the next tuple's cycle consistency, {cycle_consistency:.3}, was below the level"
+            ),
+            Self::NotSeparated { separation } => write!(
+                f,
+                "the next tuple's scores separated it from the rest by η = {separation:.3}, below the level"
+            ),
+            Self::TooSmall { area } => write!(
+                f,
+                "the next tuple covered a median {:.1} % of its shapes, below the smallest part",
+                100.0 * area
+            ),
+        }
+    }
+}
+
 /// The automatic threshold of one extracted tuple.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct AutoTuple {
@@ -1042,6 +1073,41 @@ pub struct PartsReport {
 }
 
 impl PartsReport {
+    /// A warning for the user when the parts say little: one part for the whole collection
+    /// because no tuple passed the levels (nothing was split), with the reason. `None`
+    /// otherwise, also when one part is all the upper bound allowed (`--regions 1`).
+    ///
+    /// ```
+    /// use coseg::bands::equal_count_bands;
+    /// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, PartsReport, ShapeGraph, ShapeNode};
+    /// let vals: Vec<f64> = (0..40).map(|v| ((v * 7) % 40) as f64).collect();
+    /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
+    /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
+    /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
+    /// // A separation level of 1 (a perfect split), which this data does not reach: the first
+    /// // tuple is rejected and one part remains.
+    /// let mut o = AdaptiveOptions::default();
+    /// o.min_separation = 1.0;
+    /// let a = adaptive_cosegment(&g, &o).unwrap();
+    /// let r = PartsReport::new(&a, &a.leaves, &[]);
+    /// assert_eq!(r.leaf_areas.len(), 1);
+    /// assert!(r.warning().unwrap().contains("one part for the whole collection"));
+    /// // One part because the upper bound allowed one: nothing to warn about.
+    /// let mut one = AdaptiveOptions::default();
+    /// one.max_parts = 1;
+    /// let a = adaptive_cosegment(&g, &one).unwrap();
+    /// assert_eq!(PartsReport::new(&a, &a.leaves, &[]).warning(), None);
+    /// ```
+    pub fn warning(&self) -> Option<String> {
+        (self.leaf_areas.len() == 1 && self.stop != StopReason::MaxParts).then(|| {
+            format!(
+                "parts of their own size: one part for the whole collection, since {}; \
+                 ask for a number of parts (--parts N) or try other features (docs/PARTS.md)",
+                self.stop
+            )
+        })
+    }
+
     /// The report of `adaptive` whose final segmentation (after the cut, and refinement if
     /// any) is `fin`; `meshes` (graph order, may be empty) give the pieces.
     ///
