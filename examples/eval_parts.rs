@@ -184,6 +184,7 @@ fn main() -> Res<()> {
     let mut keep: Option<f64> = None;
     let mut detail = false;
     let mut normals = 0;
+    let mut mirrors = false;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--features" => features = args.next().ok_or("--features F")?,
@@ -191,6 +192,7 @@ fn main() -> Res<()> {
             "--normals" => normals = args.next().ok_or("--normals N")?.parse()?,
             "--starts" => starts = args.next().ok_or("--starts N")?.parse()?,
             "--detail" => detail = true,
+            "--group-mirrors" => mirrors = true,
             "--keep-sizes" => keep = Some(args.next().ok_or("--keep-sizes TOL")?.parse()?),
             "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),
             "--refine-rounds" => refine_rounds = args.next().ok_or("--refine-rounds N")?.parse()?,
@@ -207,12 +209,24 @@ fn main() -> Res<()> {
     let directions = coseg::features::ExtrinsicOptions::default().directions;
     pipeline.set_families(&features, &up, directions, normals, "")?;
     let loaded = load_collection(&shapes, &pipeline, &cache, |_, _, _| {})?;
+    if mirrors {
+        let errors: Vec<String> = loaded
+            .meshes
+            .iter()
+            .map(|m| {
+                coseg::graph::mirror_plane(m).map_or("-".into(), |p| format!("{:.3}", p.error))
+            })
+            .collect();
+        println!("mirror plane errors: {}", errors.join(" "));
+    }
     for s in &loaded.skipped {
         eprintln!("skipped: {}", s.error);
     }
     for mode in &modes {
         let mut o = options(mode, refine_rounds, starts)?;
         o.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
+        o.group_mirrors = mirrors;
+        o.up = pipeline.up_direction();
         if let Some(tolerance) = keep {
             o.refine_sizes = coseg::graph::RefineSizes::Keep { tolerance };
         }
@@ -230,9 +244,14 @@ fn main() -> Res<()> {
             })
             .collect();
         let extra = out.adaptive.as_ref().map_or(String::new(), |a| {
+            let pairs = coseg::graph::mirror_pairs(&loaded.meshes, &a.leaves, o.up);
             format!(
-                " leaves {} stop {:?} t {:?}",
+                " leaves {} mirror pairs {:?} stop {:?} t {:?}",
                 a.leaves.tuples.len(),
+                pairs
+                    .iter()
+                    .map(|m| (m.a, m.b, (100.0 * m.ratio).round() / 100.0))
+                    .collect::<Vec<_>>(),
                 a.stop,
                 a.auto.iter().map(|x| x.t).collect::<Vec<_>>()
             )

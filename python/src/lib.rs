@@ -624,6 +624,7 @@ fn segment<'py>(
     } = loaded;
     // As `coseg segment`: the families' weights over the table's columns.
     seg_opts.feature_weights = pipe.feature_weights(nodes[0].bands.features);
+    seg_opts.up = pipe.up_direction();
     let result = py
         .detach(|| segment_collection(nodes, &meshes, &seg_opts))
         .or_raise()?;

@@ -143,11 +143,16 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
     if let (Some(a), Some(report)) = (&result.adaptive, result.parts_report(&loaded.meshes)) {
         if !super::quiet() {
             println!(
-                "parts: {} finest ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}",
+                "parts: {} finest ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}; mirror pairs (left/right copies): {:?}",
                 a.leaves.tuples.len(),
                 a.stop,
                 seg.tuples.len(),
-                report.mirror_candidates
+                report.mirror_candidates,
+                report
+                    .mirror_pairs
+                    .iter()
+                    .map(|m| (m.a, m.b))
+                    .collect::<Vec<_>>()
             );
         }
         if let Some(w) = report.warning() {
@@ -215,6 +220,7 @@ fn collection_options(
     o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
     o2.starts = args.starts;
     o2.refine_sizes = args.refine_sizes.unwrap_or_default();
+    o2.up = pipeline.up_direction();
     if let Some(p) = args.parts {
         o2.request_parts(p, args.regions);
     }

@@ -327,6 +327,34 @@ impl AdaptiveCosegmentation {
     }
 }
 
+impl AdaptiveCosegmentation {
+    /// Rebuilds [`Self::tree`] with the leaf pairs in `first` merged before anything else, in
+    /// their order (pairs that repeat a leaf or name no leaf are skipped); the other merges
+    /// follow the similarity of the module docs. `graph` must be the one the leaves were
+    /// found on. Used to keep mirror pairs ([`super::mirror_pairs`]) together in every cut.
+    ///
+    /// ```
+    /// use coseg::bands::equal_count_bands;
+    /// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, ShapeGraph, ShapeNode};
+    /// let vals: Vec<f64> = (0..40).map(|v| ((v * 7) % 40) as f64).collect();
+    /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
+    /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
+    /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
+    /// let mut o = AdaptiveOptions::default();
+    /// o.min_separation = 0.0;
+    /// let mut a = adaptive_cosegment(&g, &o).unwrap();
+    /// let l = a.leaves.tuples.len();
+    /// assert!(l >= 3);
+    /// a.regroup(&g, &[(0, l - 1)]);
+    /// assert_eq!((a.tree.merges[0].a, a.tree.merges[0].b), (0, l - 1));
+    /// assert_eq!(a.tree.merges.len(), l - 1);
+    /// ```
+    pub fn regroup(&mut self, graph: &ShapeGraph, first: &[(usize, usize)]) {
+        let mut sw = Sweeper::new(graph, self.leaves.order.clone(), 1);
+        self.tree = part_tree(&mut sw, &self.leaves, first);
+    }
+}
+
 fn merge_tuples<'a>(group: impl Iterator<Item = &'a RegionTuple>, n: usize) -> RegionTuple {
     let group: Vec<&RegionTuple> = group.collect();
     let mut regions = vec![Vec::new(); n];
@@ -776,7 +804,7 @@ pub fn adaptive_cosegment(
         alpha,
         tuples,
     };
-    let tree = part_tree(&mut sw, &leaves);
+    let tree = part_tree(&mut sw, &leaves, &[]);
     Ok(AdaptiveCosegmentation {
         leaves,
         auto,
@@ -990,8 +1018,9 @@ fn transport_sums(sw: &mut Sweeper<'_>, coseg: &Cosegmentation, u: &[usize]) -> 
     out
 }
 
-/// The merge tree of the module docs over the tuples of `coseg`.
-fn part_tree(sw: &mut Sweeper<'_>, coseg: &Cosegmentation) -> PartTree {
+/// The merge tree of the module docs over the tuples of `coseg`; the leaf pairs in `first`
+/// (disjoint) are merged before anything else, in their order.
+fn part_tree(sw: &mut Sweeper<'_>, coseg: &Cosegmentation, first: &[(usize, usize)]) -> PartTree {
     let l = coseg.tuples.len();
     let n = coseg.names.len();
     let mut members: Vec<Vec<usize>> = (0..l).map(|x| vec![x]).collect();
@@ -1011,27 +1040,44 @@ fn part_tree(sw: &mut Sweeper<'_>, coseg: &Cosegmentation) -> PartTree {
             (sx / ax) / (su / au)
         }
     };
+    let similarity = |sums: &[Vec<Vec<f64>>], members: &[Vec<usize>], a: usize, b: usize| {
+        (0..n)
+            .map(|i| {
+                0.5 * (rho(&sums[a], &members[a], &members[b], i)
+                    + rho(&sums[b], &members[b], &members[a], i))
+            })
+            .sum::<f64>()
+            / n as f64
+    };
     let mut merges = Vec::new();
+    let mut seen = vec![false; l];
+    let mut forced: Vec<(usize, usize)> = Vec::new();
+    for &(a, b) in first {
+        if a != b && a.max(b) < l && !seen[a] && !seen[b] {
+            seen[a] = true;
+            seen[b] = true;
+            forced.push((a.min(b), a.max(b)));
+        }
+    }
     while alive.iter().filter(|&&a| a).count() > 1 {
-        let mut best: Option<(f64, usize, usize)> = None;
+        let mut best: Option<(f64, usize, usize)> = forced
+            .get(merges.len())
+            .map(|&(a, b)| (similarity(&sums, &members, a, b), a, b));
         for a in 0..members.len() {
+            if merges.len() < forced.len() {
+                break;
+            }
             for b in a + 1..members.len() {
                 if !(alive[a] && alive[b]) {
                     continue;
                 }
-                let s = (0..n)
-                    .map(|i| {
-                        0.5 * (rho(&sums[a], &members[a], &members[b], i)
-                            + rho(&sums[b], &members[b], &members[a], i))
-                    })
-                    .sum::<f64>()
-                    / n as f64;
+                let s = similarity(&sums, &members, a, b);
                 if best.is_none_or(|(bs, _, _)| s > bs) {
                     best = Some((s, a, b));
                 }
             }
         }
-        let Some((similarity, a, b)) = best else {
+        let Some((sim, a, b)) = best else {
             break;
         };
         alive[a] = false;
@@ -1042,7 +1088,11 @@ fn part_tree(sw: &mut Sweeper<'_>, coseg: &Cosegmentation) -> PartTree {
         sums.push(transport_sums(sw, coseg, &m));
         members.push(m);
         alive.push(true);
-        merges.push(PartMerge { a, b, similarity });
+        merges.push(PartMerge {
+            a,
+            b,
+            similarity: sim,
+        });
     }
     PartTree { leaves: l, merges }
 }
@@ -1070,6 +1120,9 @@ pub struct PartsReport {
     /// family (`--features spectral,extrinsic --up AXIS`, an aligned collection) heights along
     /// tilted directions tell the copies apart, and they can become parts of their own.
     pub mirror_candidates: Vec<usize>,
+    /// Pairs of final region ids that are left/right copies of one part
+    /// ([`super::mirror_pairs`]; empty without meshes): what an extrinsic family splits.
+    pub mirror_pairs: Vec<super::MirrorPair>,
 }
 
 impl PartsReport {
@@ -1089,14 +1142,14 @@ impl PartsReport {
     /// let mut o = AdaptiveOptions::default();
     /// o.min_separation = 1.0;
     /// let a = adaptive_cosegment(&g, &o).unwrap();
-    /// let r = PartsReport::new(&a, &a.leaves, &[]);
+    /// let r = PartsReport::new(&a, &a.leaves, &[], None);
     /// assert_eq!(r.leaf_areas.len(), 1);
     /// assert!(r.warning().unwrap().contains("one part for the whole collection"));
     /// // One part because the upper bound allowed one: nothing to warn about.
     /// let mut one = AdaptiveOptions::default();
     /// one.max_parts = 1;
     /// let a = adaptive_cosegment(&g, &one).unwrap();
-    /// assert_eq!(PartsReport::new(&a, &a.leaves, &[]).warning(), None);
+    /// assert_eq!(PartsReport::new(&a, &a.leaves, &[], None).warning(), None);
     /// ```
     pub fn warning(&self) -> Option<String> {
         (self.leaf_areas.len() == 1 && self.stop != StopReason::MaxParts).then(|| {
@@ -1109,7 +1162,8 @@ impl PartsReport {
     }
 
     /// The report of `adaptive` whose final segmentation (after the cut, and refinement if
-    /// any) is `fin`; `meshes` (graph order, may be empty) give the pieces.
+    /// any) is `fin`; `meshes` (graph order, may be empty) give the pieces and the mirror
+    /// pairs, `up` (the aligned collection's up direction, if any) the mirror test's planes.
     ///
     /// ```
     /// use coseg::bands::equal_count_bands;
@@ -1119,14 +1173,15 @@ impl PartsReport {
     /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
     /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
     /// let a = adaptive_cosegment(&g, &AdaptiveOptions::default()).unwrap();
-    /// let r = PartsReport::new(&a, &a.leaves, &[]);
+    /// let r = PartsReport::new(&a, &a.leaves, &[], None);
     /// assert_eq!(r.region_leaves.len(), a.leaves.tuples.len());
-    /// assert!(r.pieces.is_none());
+    /// assert!(r.pieces.is_none() && r.mirror_pairs.is_empty());
     /// ```
     pub fn new(
         adaptive: &AdaptiveCosegmentation,
         fin: &Cosegmentation,
         meshes: &[crate::mesh::TriMesh],
+        up: Option<[f64; 3]>,
     ) -> Self {
         let mut region_leaves = adaptive.tree.cut(fin.tuples.len());
         let leftover_leaf = adaptive.leaves.tuples.len().saturating_sub(1);
@@ -1171,6 +1226,7 @@ impl PartsReport {
             region_leaves,
             pieces,
             mirror_candidates,
+            mirror_pairs: super::mirror_pairs(meshes, fin, up),
         }
     }
 }

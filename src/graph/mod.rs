@@ -11,6 +11,8 @@
 //!   in that function's module).
 //! - [`adaptive_cosegment`]: the same with each tuple's size found from the data
 //!   (Algorithm 3 across the graph), the number of parts from the data and a tree of parts.
+//! - [`mirror_pairs`]: which tuples are left/right copies of each other (each shape's own
+//!   plane of mirror symmetry, [`mirror_plane`]); the part tree merges them first.
 //! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
 //!   boundaries over every edge of the graph.
 //! - [`segment_collection`]: graph, co-segmentation and refinement in one call, as
@@ -21,6 +23,7 @@ mod adaptive_cosegment;
 mod cosegment;
 mod cycle_consistency;
 mod load_collection;
+mod mirror_pairs;
 mod refine_cosegmentation;
 mod segment_collection;
 mod shape_graph;
@@ -35,6 +38,7 @@ pub use cycle_consistency::{CycleConsistency, cycle_consistency};
 pub use load_collection::{
     LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
 };
+pub use mirror_pairs::{MIRROR_PAIR_RATIO, MirrorPair, MirrorPlane, mirror_pairs, mirror_plane};
 pub use refine_cosegmentation::{
     MIN_KEPT_SHARE, RefineSizes, refine_cosegmentation, refine_cosegmentation_sized,
 };

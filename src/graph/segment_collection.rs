@@ -4,7 +4,8 @@
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    PartsReport, RefineSizes, adaptive_cosegment, cosegment, refine_cosegmentation_sized,
+    PartsReport, RefineSizes, adaptive_cosegment, cosegment, mirror_pairs,
+    refine_cosegmentation_sized,
 };
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -50,6 +51,17 @@ pub struct SegmentCollectionOptions {
     /// stage read from the data (measured on both sides in docs/PARTS.md).
     #[serde(skip_serializing_if = "is_free")]
     pub refine_sizes: RefineSizes,
+    /// With [`Self::parts`]: merge mirror pairs of leaves ([`super::mirror_pairs`], left and
+    /// right copies of a part) first in the part tree, so every cut (`--parts N`) keeps the
+    /// two sides of a part together. Needs the meshes; without them nothing changes.
+    #[serde(skip_serializing_if = "std::ops::Not::not")]
+    pub group_mirrors: bool,
+    /// The collection's up direction in file coordinates when it is aligned (`coseg segment
+    /// --up` with the extrinsic family: [`crate::pipeline::ShapePipelineOptions::up_direction`]);
+    /// the mirror-pair test then uses vertical planes ([`super::mirror_pairs`]). Default `None`.
+    /// Not serialised: the feature options that imply it are recorded with them.
+    #[serde(skip)]
+    pub up: Option<[f64; 3]>,
 }
 
 fn is_free(r: &RefineSizes) -> bool {
@@ -143,6 +155,8 @@ impl Default for SegmentCollectionOptions {
             parts: None,
             starts: 1,
             refine_sizes: RefineSizes::Free,
+            group_mirrors: false,
+            up: None,
         }
     }
 }
@@ -175,6 +189,8 @@ pub struct SegmentedCollection {
     pub start: usize,
     /// The selection score of every start: the mean confidence of its final tuples.
     pub start_scores: Vec<f64>,
+    /// [`SegmentCollectionOptions::up`], for the mirror pairs of [`Self::parts_report`].
+    pub up: Option<[f64; 3]>,
 }
 
 impl SegmentedCollection {
@@ -184,7 +200,7 @@ impl SegmentedCollection {
     pub fn parts_report(&self, meshes: &[TriMesh]) -> Option<PartsReport> {
         self.adaptive
             .as_ref()
-            .map(|a| PartsReport::new(a, &self.segmentation, meshes))
+            .map(|a| PartsReport::new(a, &self.segmentation, meshes, self.up))
     }
 }
 
@@ -294,7 +310,16 @@ pub fn segment_collection(
                 (cosegment(&graph, &o)?, None)
             }
             Some(p) => {
-                let a = adaptive_cosegment(&graph, p)?;
+                let mut a = adaptive_cosegment(&graph, p)?;
+                if options.group_mirrors {
+                    let pairs: Vec<(usize, usize)> = mirror_pairs(meshes, &a.leaves, options.up)
+                        .iter()
+                        .map(|m| (m.a, m.b))
+                        .collect();
+                    if !pairs.is_empty() {
+                        a.regroup(&graph, &pairs);
+                    }
+                }
                 (a.cut(p.parts.unwrap_or(usize::MAX)), Some(a))
             }
         };
@@ -324,5 +349,6 @@ pub fn segment_collection(
         adaptive,
         start,
         start_scores,
+        up: options.up,
     })
 }

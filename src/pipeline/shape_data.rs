@@ -97,6 +97,31 @@ impl ShapePipelineOptions {
         Ok(())
     }
 
+    /// The up direction in file coordinates (unit) when the extrinsic family is on with an
+    /// aligned collection (`--up y`, …); `None` without it or with `--up pca`. What the
+    /// mirror-pair test of the collection stage uses
+    /// ([`crate::graph::SegmentCollectionOptions::up`]).
+    ///
+    /// ```
+    /// use coseg::pipeline::ShapePipelineOptions;
+    /// let mut o = ShapePipelineOptions::default();
+    /// assert_eq!(o.up_direction(), None);
+    /// o.set_families("spectral,extrinsic", "-z", 100, 0, "").unwrap();
+    /// assert_eq!(o.up_direction(), Some([0.0, 0.0, -1.0]));
+    /// o.set_families("spectral,extrinsic", "pca", 100, 0, "").unwrap();
+    /// assert_eq!(o.up_direction(), None);
+    /// ```
+    pub fn up_direction(&self) -> Option<[f64; 3]> {
+        match self.families.extrinsic.as_ref()?.alignment {
+            crate::features::Alignment::Up(a) => {
+                let mut u = [0.0; 3];
+                u[a.index] = if a.positive { 1.0 } else { -1.0 };
+                Some(u)
+            }
+            crate::features::Alignment::Pca => None,
+        }
+    }
+
     /// Per-column affinity weights for a feature table of `features` columns made under these
     /// options ([`FeatureFamilies::feature_weights`]; the user family's count is what remains
     /// after the others). `None`: one family, equal weights.

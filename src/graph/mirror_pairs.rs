@@ -1,0 +1,362 @@
+//! [`mirror_pairs`]: which parts of a co-segmentation are left/right copies of each other.
+//!
+//! Intrinsic features cannot tell a left arm from a right one, so a tuple found with them holds
+//! both (reported as a mirror candidate by its pieces, [`super::PartsReport`]); an extrinsic
+//! family (heights along tilted directions) splits them into two tuples. The second case is
+//! the one found here: tuples `a` and `b` are a mirror pair when, on most shapes, reflecting
+//! `a`'s centroid across a plane of the shape lands near `b`'s, relative to how far apart they
+//! are. Each shape uses its own plane, so the test needs no correspondence beyond the tuples.
+//!
+//! Entry points: [`mirror_plane`] (one mesh), [`mirror_pairs`] (a co-segmentation over its
+//! meshes, with each shape's plane or, for an aligned collection, vertical planes). The part tree merges mirror pairs before anything else
+//! ([`super::AdaptiveCosegmentation::regroup`]), so `--parts N` keeps the two sides of a part
+//! together.
+
+use super::Cosegmentation;
+use crate::mesh::TriMesh;
+use serde::Serialize;
+use std::collections::HashMap;
+
+/// A plane of approximate mirror symmetry of one shape.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MirrorPlane {
+    /// A point of the plane: the surface's area centroid (file units).
+    pub point: [f64; 3],
+    /// Unit normal (one of the surface's principal axes).
+    pub normal: [f64; 3],
+    /// Asymmetry: area-weighted mean distance from each reflected vertex to the nearest vertex,
+    /// capped at [`MirrorPlane::DISTANCE_CAP`], over the RMS radius of the surface (0 = exact
+    /// mirror symmetry; dimensionless).
+    pub error: f64,
+}
+
+impl MirrorPlane {
+    /// Distances from a reflected vertex to the surface are counted up to this share of the
+    /// RMS radius: far is far, and the cap bounds the nearest-vertex search.
+    pub const DISTANCE_CAP: f64 = 0.25;
+
+    /// Planes with an asymmetry up to this are used by [`mirror_pairs`]. A shape whose best
+    /// plane is worse has no usable symmetry (the level sits between the generated families'
+    /// plane errors, 0.01–0.03 with independent left/right poses, and the error of a plane
+    /// across an asymmetric axis, 0.08 and more: docs/PARTS.md).
+    pub const MAX_ERROR: f64 = 0.05;
+
+    /// `p` reflected across the plane.
+    pub fn reflect(&self, p: [f64; 3]) -> [f64; 3] {
+        let d = (0..3)
+            .map(|k| (p[k] - self.point[k]) * self.normal[k])
+            .sum::<f64>();
+        [
+            p[0] - 2.0 * d * self.normal[0],
+            p[1] - 2.0 * d * self.normal[1],
+            p[2] - 2.0 * d * self.normal[2],
+        ]
+    }
+}
+
+/// The best plane of mirror symmetry of `mesh` among the three planes through its area
+/// centroid normal to its principal axes (a mirror symmetry's plane is always one of these);
+/// `None` for a mesh without area. Cost: one nearest-vertex query per vertex and candidate,
+/// on a uniform grid.
+///
+/// Inputs: `mesh` (#V vertices). Output: the plane of least [`MirrorPlane::error`]. See also
+/// [`mirror_pairs`].
+///
+/// ```
+/// use coseg::graph::mirror_plane;
+/// use coseg::mesh::TriMesh;
+/// // A prism along x with a scalene cross-section: mirror-symmetric across x = 1 only.
+/// let ring = [(0.0, 0.0), (0.5, 0.0), (0.2, 0.3)];
+/// let mut p = Vec::new();
+/// for i in 0..=4 { for (y, z) in ring { p.push([i as f64 * 0.5, y, z]); } }
+/// // Each quad is cut along the diagonal that the mirror image of its partner quad uses, so
+/// // the triangulation (and the vertex areas) are symmetric too.
+/// let mut f = Vec::new();
+/// for i in 0..4u32 { for k in 0..3u32 {
+///     let (a, b, c, d) = (3 * i + k, 3 * i + (k + 1) % 3, 3 * (i + 1) + (k + 1) % 3, 3 * (i + 1) + k);
+///     if i < 2 { f.push([a, b, c]); f.push([a, c, d]); } else { f.push([a, b, d]); f.push([b, c, d]); }
+/// } }
+/// let plane = mirror_plane(&TriMesh::new(p, f).unwrap()).unwrap();
+/// assert!(plane.error < 1e-12);
+/// assert!(plane.normal[0].abs() > 0.999 && (plane.point[0] - 1.0).abs() < 1e-12);
+/// ```
+pub fn mirror_plane(mesh: &TriMesh) -> Option<MirrorPlane> {
+    let pos = mesh.positions();
+    let w = mesh.vertex_areas();
+    let total: f64 = w.iter().sum();
+    if total.is_nan() || total <= 0.0 || pos.is_empty() {
+        return None;
+    }
+    let mut c = [0.0; 3];
+    for (p, &a) in pos.iter().zip(&w) {
+        (0..3).for_each(|k| c[k] += a * p[k]);
+    }
+    c.iter_mut().for_each(|x| *x /= total);
+    let mut cov = nalgebra::Matrix3::<f64>::zeros();
+    for (p, &a) in pos.iter().zip(&w) {
+        let q = nalgebra::Vector3::new(p[0] - c[0], p[1] - c[1], p[2] - c[2]);
+        cov += a * q * q.transpose();
+    }
+    cov /= total;
+    let radius = cov.trace().sqrt();
+    if radius.is_nan() || radius <= 0.0 {
+        return None;
+    }
+    let cap = MirrorPlane::DISTANCE_CAP * radius;
+    let grid = Grid::new(pos, cap / 4.0);
+    let eig = nalgebra::SymmetricEigen::new(cov);
+    let mut order = [0usize, 1, 2];
+    // Largest variance first, so that ties between equal errors pick a stable axis.
+    order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
+    order
+        .iter()
+        .map(|&k| {
+            let e = eig.eigenvectors.column(k);
+            let mut plane = MirrorPlane {
+                point: c,
+                normal: [e[0], e[1], e[2]],
+                error: 0.0,
+            };
+            let err: f64 = pos
+                .iter()
+                .zip(&w)
+                .map(|(p, &a)| a * grid.nearest(pos, plane.reflect(*p), cap))
+                .sum();
+            plane.error = err / total / radius;
+            plane
+        })
+        .min_by(|a, b| a.error.total_cmp(&b.error))
+}
+
+/// Uniform grid over the vertices for capped nearest-vertex queries.
+struct Grid {
+    cell: f64,
+    cells: HashMap<[i64; 3], Vec<u32>>,
+}
+
+impl Grid {
+    fn new(pos: &[[f64; 3]], cell: f64) -> Self {
+        let mut cells: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+        for (v, p) in pos.iter().enumerate() {
+            cells.entry(Self::key(p, cell)).or_default().push(v as u32);
+        }
+        Self { cell, cells }
+    }
+
+    fn key(p: &[f64; 3], cell: f64) -> [i64; 3] {
+        [0, 1, 2].map(|k| (p[k] / cell).floor() as i64)
+    }
+
+    /// Distance from `q` to the nearest vertex, or `cap` when none is closer.
+    fn nearest(&self, pos: &[[f64; 3]], q: [f64; 3], cap: f64) -> f64 {
+        let k = Self::key(&q, self.cell);
+        let rings = (cap / self.cell).ceil() as i64;
+        let mut best = cap * cap;
+        for r in 0..=rings {
+            // Every point in ring r is at least (r − 1) cells away.
+            let near = ((r - 1).max(0) as f64) * self.cell;
+            if near * near >= best {
+                break;
+            }
+            for dx in -r..=r {
+                for dy in -r..=r {
+                    for dz in -r..=r {
+                        if dx.abs().max(dy.abs()).max(dz.abs()) != r {
+                            continue;
+                        }
+                        if let Some(vs) = self.cells.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
+                            for &v in vs {
+                                let p = pos[v as usize];
+                                let d = (0..3).map(|j| (p[j] - q[j]).powi(2)).sum::<f64>();
+                                best = best.min(d);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        best.sqrt()
+    }
+}
+
+/// Two tuples that are mirror images of each other (left and right copies of one part).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct MirrorPair {
+    /// The first tuple (the smaller index).
+    pub a: usize,
+    /// The second tuple.
+    pub b: usize,
+    /// Median over the shapes used of `|R c_a − c_b| / |c_a − c_b|` (`R` the shape's
+    /// reflection, `c` the regions' area centroids): 0 for exact mirror images, about 1 for
+    /// two regions on the plane or on one side.
+    pub ratio: f64,
+}
+
+/// Mirror pairs are pairs whose median ratio is below this: the reflected centroid lands
+/// closer to the other region than a third of their distance.
+pub const MIRROR_PAIR_RATIO: f64 = 1.0 / 3.0;
+
+/// The mirror pairs among the tuples of `coseg` (graph order; `meshes[i]` is shape `i`).
+///
+/// On each shape, tuples `a` and `b` are compared by the ratio of [`MirrorPair::ratio`] under
+/// a reflection:
+/// - `up = None`: the shape's own [`mirror_plane`], and only on shapes where its error is
+///   ≤ [`MirrorPlane::MAX_ERROR`];
+/// - `up = Some(u)` (an aligned collection, `u` the up direction in file coordinates; any
+///   length): the vertical plane through the shape's area centroid whose normal is the
+///   horizontal part of `c_a − c_b`. Articulated shapes (a humanoid with its arms in
+///   different poses) have no global mirror plane, but their left and right parts still sit
+///   at about the same height, at about the same distance on either side of the centroid.
+///
+/// A shape takes part when both regions are non-empty on it; a pair needs at least half of
+/// all shapes to take part and a median ratio below [`MIRROR_PAIR_RATIO`]. Pairs are then matched greedily, lowest
+/// ratio first, so a tuple is in at most one pair. Output sorted by ratio.
+///
+/// Inputs: `meshes` (#shapes, #V_i vertices each), `coseg` (its regions index the meshes'
+/// vertices). Empty when the meshes do not match `coseg`. See also
+/// [`super::AdaptiveCosegmentation::regroup`], [`super::PartsReport::mirror_pairs`].
+///
+/// ```
+/// use coseg::graph::{mirror_pairs, Cosegmentation, RegionTuple};
+/// use coseg::mesh::TriMesh;
+/// // A flat strip along x (up = y): a left end, a middle and a right end.
+/// let p: Vec<[f64; 3]> = (0..10).map(|i| [(i / 2) as f64, (i % 2) as f64, 0.0]).collect();
+/// let f: Vec<[u32; 3]> = (0..4u32).flat_map(|k| { let a = 2 * k;
+///     if k < 2 { [[a, a + 2, a + 1], [a + 1, a + 2, a + 3]] } else { [[a, a + 3, a + 1], [a, a + 2, a + 3]] } }).collect();
+/// let mesh = TriMesh::new(p, f).unwrap();
+/// let tuple = |r: Vec<u32>| RegionTuple { area_fractions: vec![0.0], regions: vec![r], sweeps: 0,
+///     converged: true, cycled: false, objective: 0.0, confidence: 1.0, cycle_consistency: None,
+///     leftover: false };
+/// let coseg = Cosegmentation { names: vec!["s".into()], vertices: vec![10], root: 0, order: vec![0],
+///     parent: vec![None], alpha: 0.25,
+///     tuples: vec![tuple(vec![0, 1]), tuple(vec![2, 3, 4, 5, 6, 7]), tuple(vec![8, 9])] };
+/// let pairs = mirror_pairs(&[mesh], &coseg, Some([0.0, 1.0, 0.0]));
+/// assert_eq!((pairs.len(), pairs[0].a, pairs[0].b), (1, 0, 2));
+/// assert!(pairs[0].ratio < 1e-12);
+/// ```
+pub fn mirror_pairs(
+    meshes: &[TriMesh],
+    coseg: &Cosegmentation,
+    up: Option<[f64; 3]>,
+) -> Vec<MirrorPair> {
+    let up = up.and_then(unit);
+    let n = coseg.names.len();
+    if meshes.len() != n
+        || meshes
+            .iter()
+            .zip(&coseg.vertices)
+            .any(|(m, &d)| m.vertex_count() != d)
+    {
+        return Vec::new();
+    }
+    let l = coseg.tuples.len();
+    // Per shape with a usable plane: the plane and each tuple's area centroid.
+    let shapes: Vec<Option<ShapeCentroids>> = meshes
+        .iter()
+        .enumerate()
+        .map(|(i, mesh)| {
+            let plane = match up {
+                // Only the centroid is used: each pair gets its own vertical plane.
+                Some(_) => mirror_plane(mesh)?,
+                None => mirror_plane(mesh).filter(|p| p.error <= MirrorPlane::MAX_ERROR)?,
+            };
+            let w = mesh.vertex_areas();
+            let pos = mesh.positions();
+            let centroids = coseg
+                .tuples
+                .iter()
+                .map(|t| {
+                    let r = &t.regions[i];
+                    let a: f64 = r.iter().map(|&v| w[v as usize]).sum();
+                    (a > 0.0).then(|| {
+                        let mut c = [0.0; 3];
+                        for &v in r {
+                            (0..3).for_each(|k| c[k] += w[v as usize] * pos[v as usize][k]);
+                        }
+                        c.map(|x| x / a)
+                    })
+                })
+                .collect();
+            Some((plane, centroids))
+        })
+        .collect();
+    let mut candidates = Vec::new();
+    for a in 0..l {
+        for b in a + 1..l {
+            let mut ratios: Vec<f64> = shapes
+                .iter()
+                .flatten()
+                .filter_map(|(plane, c)| {
+                    let (ca, cb) = (c[a]?, c[b]?);
+                    let apart = dist(ca, cb);
+                    if apart.is_nan() || apart <= 0.0 {
+                        return None;
+                    }
+                    let plane = match up {
+                        Some(u) => vertical_plane(plane.point, u, ca, cb)?,
+                        None => *plane,
+                    };
+                    Some(dist(plane.reflect(ca), cb) / apart)
+                })
+                .collect();
+            if 2 * ratios.len() < n || ratios.is_empty() {
+                continue;
+            }
+            ratios.sort_by(f64::total_cmp);
+            let m = ratios.len();
+            let ratio = if m % 2 == 1 {
+                ratios[m / 2]
+            } else {
+                0.5 * (ratios[m / 2 - 1] + ratios[m / 2])
+            };
+            if ratio < MIRROR_PAIR_RATIO {
+                candidates.push(MirrorPair { a, b, ratio });
+            }
+        }
+    }
+    candidates.sort_by(|x, y| x.ratio.total_cmp(&y.ratio));
+    let mut used = vec![false; l];
+    candidates
+        .into_iter()
+        .filter(|p| {
+            let free = !used[p.a] && !used[p.b];
+            if free {
+                used[p.a] = true;
+                used[p.b] = true;
+            }
+            free
+        })
+        .collect()
+}
+
+/// The vertical plane (containing `up`, unit) through `point` across which `ca` and `cb` come
+/// closest to exchanging: its normal is the horizontal part of `ca − cb`. `None` when the two
+/// are on one vertical line (no vertical plane exchanges them).
+fn vertical_plane(
+    point: [f64; 3],
+    up: [f64; 3],
+    ca: [f64; 3],
+    cb: [f64; 3],
+) -> Option<MirrorPlane> {
+    let d = [0, 1, 2].map(|k| ca[k] - cb[k]);
+    let h: f64 = (0..3).map(|k| d[k] * up[k]).sum();
+    let normal = unit([0, 1, 2].map(|k| d[k] - h * up[k]))?;
+    Some(MirrorPlane {
+        point,
+        normal,
+        error: 0.0,
+    })
+}
+
+fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
+    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    (len > 1e-12 * (1.0 + v.iter().map(|x| x.abs()).fold(0.0, f64::max)))
+        .then(|| v.map(|x| x / len))
+}
+
+/// A shape's plane and each tuple's area centroid on it (`None`: empty there).
+type ShapeCentroids = (MirrorPlane, Vec<Option<[f64; 3]>>);
+
+fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
+    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
+}

@@ -1,0 +1,173 @@
+//! Tests of the mirror-pair test (`graph::mirror_plane`, `graph::mirror_pairs`) and of the part
+//! tree that merges mirror pairs first (`AdaptiveCosegmentation::regroup`).
+
+use coseg::graph::{Cosegmentation, MirrorPlane, RegionTuple, mirror_pairs, mirror_plane};
+use coseg::mesh::TriMesh;
+
+/// Boxes (centre, half sizes) as one mesh; per box, its 14 vertex ids.
+fn figure(boxes: &[([f64; 3], [f64; 3])]) -> (TriMesh, Vec<Vec<u32>>) {
+    let mut p = Vec::new();
+    let mut f = Vec::new();
+    let mut parts = Vec::new();
+    for (c, h) in boxes {
+        let o = p.len() as u32;
+        for k in 0..8 {
+            let s = |b: u32| if k >> b & 1 == 1 { 1.0 } else { -1.0 };
+            p.push([c[0] + s(0) * h[0], c[1] + s(1) * h[1], c[2] + s(2) * h[2]]);
+        }
+        // Corner k has bit 0 = x, bit 1 = y, bit 2 = z. Each face is cut into four triangles
+        // around its centre, so the vertex areas are as symmetric as the box.
+        for q in [
+            [0, 2, 3, 1],
+            [4, 5, 7, 6],
+            [0, 1, 5, 4],
+            [2, 6, 7, 3],
+            [0, 4, 6, 2],
+            [1, 3, 7, 5],
+        ] {
+            let m = p.len() as u32;
+            let centre = |k: usize| q.iter().map(|&v| p[(o + v) as usize][k]).sum::<f64>() / 4.0;
+            p.push([centre(0), centre(1), centre(2)]);
+            for e in 0..4 {
+                f.push([o + q[e], o + q[(e + 1) % 4], m]);
+            }
+        }
+        parts.push((o..p.len() as u32).collect());
+    }
+    (TriMesh::new(p, f).unwrap(), parts)
+}
+
+/// A figure standing along +y, symmetric across x = 0 except where `pose` moves the right arm
+/// (0 = mirror image of the left one): torso, left arm, right arm, head, left leg, right leg,
+/// nose (in front, +z, so that z = 0 is no plane of symmetry).
+fn person(scale: f64, pose: f64) -> (TriMesh, Vec<Vec<u32>>) {
+    let s = |v: [f64; 3]| v.map(|x| x * scale);
+    figure(&[
+        (s([0.0, 0.0, 0.0]), s([0.6, 1.0, 0.3])),
+        (s([1.4, 0.6, 0.0]), s([0.8, 0.15, 0.15])),
+        (
+            s([-1.4 + 0.3 * pose, 0.6 + 0.9 * pose, 0.4 * pose]),
+            s([0.8, 0.15, 0.15]),
+        ),
+        (s([0.0, 1.5, 0.0]), s([0.3, 0.3, 0.3])),
+        (s([0.35, -2.0, 0.0]), s([0.2, 1.0, 0.2])),
+        (s([-0.35, -2.0, 0.0]), s([0.2, 1.0, 0.2])),
+        (s([0.0, 1.5, 0.45]), s([0.05, 0.05, 0.15])),
+    ])
+}
+
+fn coseg_of(meshes: &[TriMesh], parts: &[Vec<Vec<u32>>]) -> Cosegmentation {
+    let n = meshes.len();
+    let tuples = (0..parts[0].len())
+        .map(|t| RegionTuple {
+            area_fractions: vec![0.0; n],
+            regions: parts.iter().map(|p| p[t].clone()).collect(),
+            sweeps: 0,
+            converged: true,
+            cycled: false,
+            objective: 0.0,
+            confidence: 1.0,
+            cycle_consistency: None,
+            leftover: false,
+        })
+        .collect();
+    Cosegmentation {
+        names: (0..n).map(|i| format!("s{i}")).collect(),
+        vertices: meshes.iter().map(TriMesh::vertex_count).collect(),
+        root: 0,
+        order: (0..n).collect(),
+        parent: (0..n).map(|i| (i > 0).then_some(0)).collect(),
+        alpha: 0.1,
+        tuples,
+    }
+}
+
+fn pairs(p: &[coseg::graph::MirrorPair]) -> Vec<(usize, usize)> {
+    let mut v: Vec<(usize, usize)> = p.iter().map(|m| (m.a, m.b)).collect();
+    v.sort_unstable();
+    v
+}
+
+#[test]
+fn mirror_plane_of_a_symmetric_figure_is_its_plane() {
+    let (mesh, _) = person(1.0, 0.0);
+    let plane = mirror_plane(&mesh).unwrap();
+    assert!(plane.error < 1e-12, "error {}", plane.error);
+    assert!(
+        plane.normal[0].abs() > 1.0 - 1e-9,
+        "normal {:?}",
+        plane.normal
+    );
+    assert!(plane.point[0].abs() < 1e-12);
+    // Rotated and moved, the plane follows (a fixed rotation about a tilted axis).
+    let (c, s) = (0.6f64.cos(), 0.6f64.sin());
+    let moved = mesh
+        .map_positions(|p| {
+            [
+                c * p[0] - s * p[1] + 3.0,
+                s * p[0] + c * p[1] - 1.0,
+                p[2] + 0.5,
+            ]
+        })
+        .unwrap();
+    let plane = mirror_plane(&moved).unwrap();
+    assert!(plane.error < 1e-9, "error {}", plane.error);
+    let along = (plane.normal[0] * c + plane.normal[1] * s).abs();
+    assert!(along > 1.0 - 1e-9, "normal {:?}", plane.normal);
+}
+
+#[test]
+fn mirror_plane_of_a_posed_figure_reports_its_asymmetry() {
+    let (mesh, _) = person(1.0, 1.0);
+    let plane = mirror_plane(&mesh).unwrap();
+    assert!(
+        plane.error > MirrorPlane::MAX_ERROR,
+        "error {}",
+        plane.error
+    );
+}
+
+#[test]
+fn mirror_pairs_are_the_left_and_right_parts() {
+    let shapes: Vec<(TriMesh, Vec<Vec<u32>>)> =
+        [1.0, 1.2, 0.9].iter().map(|&s| person(s, 0.0)).collect();
+    let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
+    let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
+    let coseg = coseg_of(&meshes, &parts);
+    // Each shape's own plane, and vertical planes (up = +y): the arms and the legs.
+    let by_plane = mirror_pairs(&meshes, &coseg, None);
+    assert_eq!(pairs(&by_plane), vec![(1, 2), (4, 5)]);
+    assert!(by_plane.iter().all(|m| m.ratio < 1e-9));
+    assert_eq!(
+        pairs(&mirror_pairs(&meshes, &coseg, Some([0.0, 2.0, 0.0]))),
+        vec![(1, 2), (4, 5)]
+    );
+    // Meshes that do not match the co-segmentation: nothing.
+    assert!(mirror_pairs(&meshes[..2], &coseg, None).is_empty());
+}
+
+#[test]
+fn mirror_pairs_of_posed_figures_need_the_up_direction() {
+    // The right arm raised and forward differently on each shape: no plane of symmetry, but
+    // with up known the arms are still a pair; the head is never paired with the legs.
+    let shapes: Vec<(TriMesh, Vec<Vec<u32>>)> = [(1.0, 0.2), (1.1, 0.35), (0.9, 0.25)]
+        .iter()
+        .map(|&(s, p)| person(s, p))
+        .collect();
+    let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
+    let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
+    let coseg = coseg_of(&meshes, &parts);
+    let up = mirror_pairs(&meshes, &coseg, Some([0.0, 1.0, 0.0]));
+    assert_eq!(pairs(&up), vec![(1, 2), (4, 5)]);
+    // Upside down (up = −y) is the same family of vertical planes.
+    assert_eq!(
+        pairs(&mirror_pairs(&meshes, &coseg, Some([0.0, -1.0, 0.0]))),
+        vec![(1, 2), (4, 5)]
+    );
+    // A wrong up (x, sideways): left and right are then at different heights.
+    assert!(
+        pairs(&mirror_pairs(&meshes, &coseg, Some([1.0, 0.0, 0.0])))
+            .iter()
+            .all(|&p| p != (1, 2))
+    );
+}
