@@ -139,6 +139,41 @@ fn family_scores(
     Ok((part_purity(&shapes)?, part_coverage(&shapes)?))
 }
 
+/// The mirror pairs of the final regions, each region named by its majority true (ungrouped)
+/// part pooled over the shapes: a check that the pairs are left/right copies.
+fn mirror_check(
+    loaded: &LoadedCollection,
+    seg: &Cosegmentation,
+    folder: &Path,
+    up: Option<[f64; 3]>,
+) -> Res<String> {
+    let truth = GroundTruth::read(folder)?;
+    let names = &truth.manifest.parts;
+    let mut area = vec![vec![0.0; names.len()]; seg.tuples.len()];
+    for (i, mesh) in loaded.meshes.iter().enumerate() {
+        let shape = truth.shape(&seg.names[i]).ok_or("shape not in manifest")?;
+        let labels = coseg::evaluate::read_labels(truth.dir.join(&shape.labels))?;
+        let w = mesh.vertex_areas();
+        for (v, &r) in seg.labels(i).iter().enumerate() {
+            if r >= 0 && labels[v] >= 0 {
+                area[r as usize][labels[v] as usize] += w[v];
+            }
+        }
+    }
+    let major = |r: usize| {
+        let k = (0..names.len())
+            .max_by(|&x, &y| area[r][x].total_cmp(&area[r][y]))
+            .unwrap_or(0);
+        format!("{r} {}", names.get(k).map_or("?", String::as_str))
+    };
+    let pairs = coseg::graph::mirror_pairs(&loaded.meshes, seg, up);
+    Ok(pairs
+        .iter()
+        .map(|m| format!("[{} | {}] {:.2}", major(m.a), major(m.b), m.ratio))
+        .collect::<Vec<_>>()
+        .join(", "))
+}
+
 fn options(mode: &str, refine_rounds: usize, starts: usize) -> Res<SegmentCollectionOptions> {
     let mut o = SegmentCollectionOptions::default();
     // Several starts are for the equal-area mode only (segment_collection refuses them with
@@ -226,7 +261,11 @@ fn main() -> Res<()> {
         let mut o = options(mode, refine_rounds, starts)?;
         o.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
         o.group_mirrors = mirrors;
-        o.up = pipeline.up_direction();
+        o.up = if std::env::var_os("PLANE").is_some() {
+            None
+        } else {
+            pipeline.up_direction()
+        };
         if let Some(tolerance) = keep {
             o.refine_sizes = coseg::graph::RefineSizes::Keep { tolerance };
         }
@@ -256,6 +295,12 @@ fn main() -> Res<()> {
                 a.auto.iter().map(|x| x.t).collect::<Vec<_>>()
             )
         });
+        if mirrors && !coseg_set {
+            println!(
+                "  final mirror pairs: {}",
+                mirror_check(&loaded, seg, &folder, o.up)?
+            );
+        }
         let score = if coseg_set {
             format!(
                 "accuracy {:.1} %",

@@ -171,3 +171,30 @@ fn mirror_pairs_of_posed_figures_need_the_up_direction() {
             .all(|&p| p != (1, 2))
     );
 }
+
+#[test]
+fn mirror_pairs_need_copies_of_one_size() {
+    // A body with two blocks opposite each other at one height: paired when they have one
+    // size, not when one has a third of the other's area (a head and a tail).
+    let pair_of = |half: f64| {
+        let shapes: Vec<(TriMesh, Vec<Vec<u32>>)> = [1.0, 1.1, 0.9]
+            .iter()
+            .map(|&s| {
+                figure(&[
+                    ([0.0, 0.0, 0.0], [1.0 * s, 0.5, 0.5]),
+                    ([1.5 * s, 0.0, 0.0], [0.3, 0.3, 0.3]),
+                    ([-1.5 * s, 0.0, 0.0], [0.3, half, half]),
+                ])
+            })
+            .collect();
+        let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
+        let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
+        pairs(&mirror_pairs(
+            &meshes,
+            &coseg_of(&meshes, &parts),
+            Some([0.0, 1.0, 0.0]),
+        ))
+    };
+    assert_eq!(pair_of(0.3), vec![(1, 2)]);
+    assert_eq!(pair_of(0.12), vec![]);
+}

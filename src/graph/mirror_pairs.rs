@@ -190,11 +190,19 @@ pub struct MirrorPair {
     /// reflection, `c` the regions' area centroids): 0 for exact mirror images, about 1 for
     /// two regions on the plane or on one side.
     pub ratio: f64,
+    /// Median over the same shapes of the smaller region's area over the larger's (1 for
+    /// copies of one size).
+    pub area_balance: f64,
 }
 
 /// Mirror pairs are pairs whose median ratio is below this: the reflected centroid lands
 /// closer to the other region than a third of their distance.
 pub const MIRROR_PAIR_RATIO: f64 = 1.0 / 3.0;
+
+/// Mirror pairs have a median area balance of at least this: copies have one size. What rules
+/// out parts that merely sit opposite each other at one height (a quadruped's head and tail,
+/// about 2 : 1).
+pub const MIRROR_AREA_BALANCE: f64 = 2.0 / 3.0;
 
 /// The mirror pairs among the tuples of `coseg` (graph order; `meshes[i]` is shape `i`).
 ///
@@ -209,7 +217,8 @@ pub const MIRROR_PAIR_RATIO: f64 = 1.0 / 3.0;
 ///   at about the same height, at about the same distance on either side of the centroid.
 ///
 /// A shape takes part when both regions are non-empty on it; a pair needs at least half of
-/// all shapes to take part and a median ratio below [`MIRROR_PAIR_RATIO`]. Pairs are then matched greedily, lowest
+/// all shapes to take part, a median ratio below [`MIRROR_PAIR_RATIO`] and a median area
+/// balance of at least [`MIRROR_AREA_BALANCE`]. Pairs are then matched greedily, lowest
 /// ratio first, so a tuple is in at most one pair. Output sorted by ratio.
 ///
 /// Inputs: `meshes` (#shapes, #V_i vertices each), `coseg` (its regions index the meshes'
@@ -273,7 +282,7 @@ pub fn mirror_pairs(
                         for &v in r {
                             (0..3).for_each(|k| c[k] += w[v as usize] * pos[v as usize][k]);
                         }
-                        c.map(|x| x / a)
+                        (c.map(|x| x / a), a)
                     })
                 })
                 .collect();
@@ -283,11 +292,11 @@ pub fn mirror_pairs(
     let mut candidates = Vec::new();
     for a in 0..l {
         for b in a + 1..l {
-            let mut ratios: Vec<f64> = shapes
+            let (mut ratios, mut balances): (Vec<f64>, Vec<f64>) = shapes
                 .iter()
                 .flatten()
                 .filter_map(|(plane, c)| {
-                    let (ca, cb) = (c[a]?, c[b]?);
+                    let ((ca, wa), (cb, wb)) = (c[a]?, c[b]?);
                     let apart = dist(ca, cb);
                     if apart.is_nan() || apart <= 0.0 {
                         return None;
@@ -296,21 +305,20 @@ pub fn mirror_pairs(
                         Some(u) => vertical_plane(plane.point, u, ca, cb)?,
                         None => *plane,
                     };
-                    Some(dist(plane.reflect(ca), cb) / apart)
+                    Some((dist(plane.reflect(ca), cb) / apart, wa.min(wb) / wa.max(wb)))
                 })
-                .collect();
+                .unzip();
             if 2 * ratios.len() < n || ratios.is_empty() {
                 continue;
             }
-            ratios.sort_by(f64::total_cmp);
-            let m = ratios.len();
-            let ratio = if m % 2 == 1 {
-                ratios[m / 2]
-            } else {
-                0.5 * (ratios[m / 2 - 1] + ratios[m / 2])
-            };
-            if ratio < MIRROR_PAIR_RATIO {
-                candidates.push(MirrorPair { a, b, ratio });
+            let (ratio, area_balance) = (median(&mut ratios), median(&mut balances));
+            if ratio < MIRROR_PAIR_RATIO && area_balance >= MIRROR_AREA_BALANCE {
+                candidates.push(MirrorPair {
+                    a,
+                    b,
+                    ratio,
+                    area_balance,
+                });
             }
         }
     }
@@ -354,8 +362,18 @@ fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
         .then(|| v.map(|x| x / len))
 }
 
-/// A shape's plane and each tuple's area centroid on it (`None`: empty there).
-type ShapeCentroids = (MirrorPlane, Vec<Option<[f64; 3]>>);
+/// A shape's plane and each tuple's area centroid and area on it (`None`: empty there).
+type ShapeCentroids = (MirrorPlane, Vec<Option<([f64; 3], f64)>>);
+
+fn median(v: &mut [f64]) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let m = v.len();
+    if m % 2 == 1 {
+        v[m / 2]
+    } else {
+        0.5 * (v[m / 2 - 1] + v[m / 2])
+    }
+}
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
