@@ -146,6 +146,7 @@ fn mirror_check(
     seg: &Cosegmentation,
     folder: &Path,
     up: Option<[f64; 3]>,
+    likeness: coseg::graph::Likeness<'_>,
 ) -> Res<String> {
     let truth = GroundTruth::read(folder)?;
     let names = &truth.manifest.parts;
@@ -166,10 +167,18 @@ fn mirror_check(
             .unwrap_or(0);
         format!("{r} {}", names.get(k).map_or("?", String::as_str))
     };
-    let pairs = coseg::graph::mirror_pairs(&loaded.meshes, seg, up);
+    let pairs = coseg::graph::mirror_pairs(&loaded.meshes, seg, up, Some(likeness));
     Ok(pairs
         .iter()
-        .map(|m| format!("[{} | {}] {:.2}", major(m.a), major(m.b), m.ratio))
+        .map(|m| {
+            format!(
+                "[{} | {}] {:.2} {:.2}",
+                major(m.a),
+                major(m.b),
+                m.ratio,
+                m.likeness.unwrap_or(f64::NAN)
+            )
+        })
         .collect::<Vec<_>>()
         .join(", "))
 }
@@ -261,11 +270,8 @@ fn main() -> Res<()> {
         let mut o = options(mode, refine_rounds, starts)?;
         o.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
         o.group_mirrors = mirrors;
-        o.up = if std::env::var_os("PLANE").is_some() {
-            None
-        } else {
-            pipeline.up_direction()
-        };
+        o.up = pipeline.up_direction();
+        o.mirror_columns = pipeline.mirror_invariant_columns(loaded.nodes[0].bands.features);
         if let Some(tolerance) = keep {
             o.refine_sizes = coseg::graph::RefineSizes::Keep { tolerance };
         }
@@ -283,7 +289,15 @@ fn main() -> Res<()> {
             })
             .collect();
         let extra = out.adaptive.as_ref().map_or(String::new(), |a| {
-            let pairs = coseg::graph::mirror_pairs(&loaded.meshes, &a.leaves, o.up);
+            let pairs = coseg::graph::mirror_pairs(
+                &loaded.meshes,
+                &a.leaves,
+                o.up,
+                Some(coseg::graph::Likeness {
+                    graph: &out.graph,
+                    columns: &o.mirror_columns,
+                }),
+            );
             format!(
                 " leaves {} mirror pairs {:?} stop {:?} t {:?}",
                 a.leaves.tuples.len(),
@@ -296,9 +310,13 @@ fn main() -> Res<()> {
             )
         });
         if mirrors && !coseg_set {
+            let likeness = coseg::graph::Likeness {
+                graph: &out.graph,
+                columns: &o.mirror_columns,
+            };
             println!(
                 "  final mirror pairs: {}",
-                mirror_check(&loaded, seg, &folder, o.up)?
+                mirror_check(&loaded, seg, &folder, o.up, likeness)?
             );
         }
         let score = if coseg_set {

@@ -150,6 +150,44 @@ fn regression_quiet_parts_auto_prints_nothing() {
     );
 }
 
+/// `--parts` with the extrinsic family on an aligned collection records its mirror pairs in
+/// summary.json (`parts.mirror_pairs`): valid region ids, each pair within the levels.
+#[test]
+fn parts_records_mirror_pairs() {
+    let dir = tempfile::tempdir().unwrap();
+    let (run, out) = segment_parts_auto(
+        dir.path(),
+        &[
+            "--features",
+            "spectral,extrinsic",
+            "--up",
+            "y",
+            "--directions",
+            "8",
+        ],
+    );
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let regions = summary["parts"]["region_leaves"].as_array().unwrap().len();
+    let pairs = summary["parts"]["mirror_pairs"]
+        .as_array()
+        .expect("mirror_pairs recorded");
+    for p in pairs {
+        let (a, b) = (p["a"].as_u64().unwrap(), p["b"].as_u64().unwrap());
+        assert!(a < b && (b as usize) < regions, "{p}");
+        assert!(
+            p["ratio"].as_f64().unwrap() < coseg::graph::MIRROR_PAIR_RATIO,
+            "{p}"
+        );
+        assert!(p["area_balance"].as_f64().unwrap() >= coseg::graph::MIRROR_AREA_BALANCE);
+        assert!(
+            p["likeness"].as_f64().unwrap() >= coseg::graph::MIRROR_LIKENESS,
+            "{p}"
+        );
+    }
+}
+
 /// `--refine-sizes`: `keep` and `keep:TOL` are recorded in summary.json (the adaptive size
 /// tolerance by default), `free` and no flag record nothing (the default mode's summary is
 /// unchanged), anything else is refused.

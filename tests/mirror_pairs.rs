@@ -1,7 +1,11 @@
 //! Tests of the mirror-pair test (`graph::mirror_plane`, `graph::mirror_pairs`) and of the part
 //! tree that merges mirror pairs first (`AdaptiveCosegmentation::regroup`).
 
-use coseg::graph::{Cosegmentation, MirrorPlane, RegionTuple, mirror_pairs, mirror_plane};
+use coseg::bands::BandTable;
+use coseg::graph::{
+    Cosegmentation, GraphOptions, Likeness, MirrorPlane, RegionTuple, ShapeGraph, ShapeNode,
+    mirror_pairs, mirror_plane,
+};
 use coseg::mesh::TriMesh;
 
 /// Boxes (centre, half sizes) as one mesh; per box, its 14 vertex ids.
@@ -135,15 +139,15 @@ fn mirror_pairs_are_the_left_and_right_parts() {
     let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
     let coseg = coseg_of(&meshes, &parts);
     // Each shape's own plane, and vertical planes (up = +y): the arms and the legs.
-    let by_plane = mirror_pairs(&meshes, &coseg, None);
+    let by_plane = mirror_pairs(&meshes, &coseg, None, None);
     assert_eq!(pairs(&by_plane), vec![(1, 2), (4, 5)]);
     assert!(by_plane.iter().all(|m| m.ratio < 1e-9));
     assert_eq!(
-        pairs(&mirror_pairs(&meshes, &coseg, Some([0.0, 2.0, 0.0]))),
+        pairs(&mirror_pairs(&meshes, &coseg, Some([0.0, 2.0, 0.0]), None)),
         vec![(1, 2), (4, 5)]
     );
     // Meshes that do not match the co-segmentation: nothing.
-    assert!(mirror_pairs(&meshes[..2], &coseg, None).is_empty());
+    assert!(mirror_pairs(&meshes[..2], &coseg, None, None).is_empty());
 }
 
 #[test]
@@ -157,16 +161,16 @@ fn mirror_pairs_of_posed_figures_need_the_up_direction() {
     let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
     let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
     let coseg = coseg_of(&meshes, &parts);
-    let up = mirror_pairs(&meshes, &coseg, Some([0.0, 1.0, 0.0]));
+    let up = mirror_pairs(&meshes, &coseg, Some([0.0, 1.0, 0.0]), None);
     assert_eq!(pairs(&up), vec![(1, 2), (4, 5)]);
     // Upside down (up = −y) is the same family of vertical planes.
     assert_eq!(
-        pairs(&mirror_pairs(&meshes, &coseg, Some([0.0, -1.0, 0.0]))),
+        pairs(&mirror_pairs(&meshes, &coseg, Some([0.0, -1.0, 0.0]), None)),
         vec![(1, 2), (4, 5)]
     );
     // A wrong up (x, sideways): left and right are then at different heights.
     assert!(
-        pairs(&mirror_pairs(&meshes, &coseg, Some([1.0, 0.0, 0.0])))
+        pairs(&mirror_pairs(&meshes, &coseg, Some([1.0, 0.0, 0.0]), None))
             .iter()
             .all(|&p| p != (1, 2))
     );
@@ -193,8 +197,76 @@ fn mirror_pairs_need_copies_of_one_size() {
             &meshes,
             &coseg_of(&meshes, &parts),
             Some([0.0, 1.0, 0.0]),
+            None,
         ))
     };
     assert_eq!(pair_of(0.3), vec![(1, 2)]);
     assert_eq!(pair_of(0.12), vec![]);
+}
+
+/// A graph over the meshes with one feature column: vertex `v`'s band is `band(part of v)`.
+fn graph_of(meshes: &[TriMesh], parts: &[Vec<Vec<u32>>], band: &[u8]) -> ShapeGraph {
+    let nodes = meshes
+        .iter()
+        .zip(parts)
+        .enumerate()
+        .map(|(i, (m, p))| {
+            let mut labels = vec![0u8; m.vertex_count()];
+            for (t, r) in p.iter().enumerate() {
+                r.iter().for_each(|&v| labels[v as usize] = band[t]);
+            }
+            let table = BandTable {
+                features: 1,
+                vertices: m.vertex_count(),
+                bands: 4,
+                labels,
+            };
+            let w = m.vertex_areas();
+            let total: f64 = w.iter().sum();
+            let areas: Vec<f64> = w.iter().map(|a| a / total).collect();
+            ShapeNode::new(format!("s{i}"), table, &areas).unwrap()
+        })
+        .collect();
+    ShapeGraph::build(nodes, &GraphOptions::default()).unwrap()
+}
+
+#[test]
+fn mirror_pairs_must_look_alike_when_the_features_say_so() {
+    // Torso and two end blocks of one size opposite each other (a head and a tail, or two
+    // arms): a pair by position alone; with an intrinsic column that gives the blocks the
+    // same band, still a pair (likeness 1); with different bands, none (likeness 0).
+    let shapes: Vec<(TriMesh, Vec<Vec<u32>>)> = [1.0, 1.1, 0.9]
+        .iter()
+        .map(|&s| {
+            figure(&[
+                ([0.0, 0.0, 0.0], [1.0 * s, 0.5, 0.5]),
+                ([1.5 * s, 0.0, 0.0], [0.3, 0.3, 0.3]),
+                ([-1.5 * s, 0.0, 0.0], [0.3, 0.3, 0.3]),
+            ])
+        })
+        .collect();
+    let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
+    let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
+    let coseg = coseg_of(&meshes, &parts);
+    let up = Some([0.0, 0.0, 1.0]);
+    let alike = graph_of(&meshes, &parts, &[0, 1, 1]);
+    let unlike = graph_of(&meshes, &parts, &[0, 1, 2]);
+    let with = |g: &ShapeGraph, columns: &[usize]| {
+        mirror_pairs(&meshes, &coseg, up, Some(Likeness { graph: g, columns }))
+    };
+    assert_eq!(
+        pairs(&mirror_pairs(&meshes, &coseg, up, None)),
+        vec![(1, 2)]
+    );
+    let p = with(&alike, &[0]);
+    assert_eq!((pairs(&p), p[0].likeness), (vec![(1, 2)], Some(1.0)));
+    assert!(with(&unlike, &[0]).is_empty());
+    // No column to compare on: position alone.
+    assert_eq!(pairs(&with(&unlike, &[])), vec![(1, 2)]);
+    let l = Likeness {
+        graph: &unlike,
+        columns: &[0],
+    };
+    assert_eq!(l.of(0, &parts[0][1], &parts[0][2]), Some(0.0));
+    assert_eq!(l.of(0, &parts[0][1], &[]), None);
 }

@@ -625,6 +625,7 @@ fn segment<'py>(
     // As `coseg segment`: the families' weights over the table's columns.
     seg_opts.feature_weights = pipe.feature_weights(nodes[0].bands.features);
     seg_opts.up = pipe.up_direction();
+    seg_opts.mirror_columns = pipe.mirror_invariant_columns(nodes[0].bands.features);
     let result = py
         .detach(|| segment_collection(nodes, &meshes, &seg_opts))
         .or_raise()?;

@@ -221,6 +221,7 @@ fn collection_options(
     o2.starts = args.starts;
     o2.refine_sizes = args.refine_sizes.unwrap_or_default();
     o2.up = pipeline.up_direction();
+    o2.mirror_columns = pipeline.mirror_invariant_columns(loaded.nodes[0].bands.features);
     if let Some(p) = args.parts {
         o2.request_parts(p, args.regions);
     }

@@ -1142,14 +1142,14 @@ impl PartsReport {
     /// let mut o = AdaptiveOptions::default();
     /// o.min_separation = 1.0;
     /// let a = adaptive_cosegment(&g, &o).unwrap();
-    /// let r = PartsReport::new(&a, &a.leaves, &[], None);
+    /// let r = PartsReport::new(&a, &a.leaves, &[], None, None);
     /// assert_eq!(r.leaf_areas.len(), 1);
     /// assert!(r.warning().unwrap().contains("one part for the whole collection"));
     /// // One part because the upper bound allowed one: nothing to warn about.
     /// let mut one = AdaptiveOptions::default();
     /// one.max_parts = 1;
     /// let a = adaptive_cosegment(&g, &one).unwrap();
-    /// assert_eq!(PartsReport::new(&a, &a.leaves, &[], None).warning(), None);
+    /// assert_eq!(PartsReport::new(&a, &a.leaves, &[], None, None).warning(), None);
     /// ```
     pub fn warning(&self) -> Option<String> {
         (self.leaf_areas.len() == 1 && self.stop != StopReason::MaxParts).then(|| {
@@ -1163,7 +1163,8 @@ impl PartsReport {
 
     /// The report of `adaptive` whose final segmentation (after the cut, and refinement if
     /// any) is `fin`; `meshes` (graph order, may be empty) give the pieces and the mirror
-    /// pairs, `up` (the aligned collection's up direction, if any) the mirror test's planes.
+    /// pairs, `up` (the aligned collection's up direction, if any) the mirror test's planes,
+    /// `likeness` what mirror pairs must look alike on ([`super::mirror_pairs`]).
     ///
     /// ```
     /// use coseg::bands::equal_count_bands;
@@ -1173,7 +1174,7 @@ impl PartsReport {
     /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
     /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
     /// let a = adaptive_cosegment(&g, &AdaptiveOptions::default()).unwrap();
-    /// let r = PartsReport::new(&a, &a.leaves, &[], None);
+    /// let r = PartsReport::new(&a, &a.leaves, &[], None, None);
     /// assert_eq!(r.region_leaves.len(), a.leaves.tuples.len());
     /// assert!(r.pieces.is_none() && r.mirror_pairs.is_empty());
     /// ```
@@ -1182,6 +1183,7 @@ impl PartsReport {
         fin: &Cosegmentation,
         meshes: &[crate::mesh::TriMesh],
         up: Option<[f64; 3]>,
+        likeness: Option<super::Likeness<'_>>,
     ) -> Self {
         let mut region_leaves = adaptive.tree.cut(fin.tuples.len());
         let leftover_leaf = adaptive.leaves.tuples.len().saturating_sub(1);
@@ -1226,7 +1228,7 @@ impl PartsReport {
             region_leaves,
             pieces,
             mirror_candidates,
-            mirror_pairs: super::mirror_pairs(meshes, fin, up),
+            mirror_pairs: super::mirror_pairs(meshes, fin, up, likeness),
         }
     }
 }

@@ -5,14 +5,15 @@
 //! family (heights along tilted directions) splits them into two tuples. The second case is
 //! the one found here: tuples `a` and `b` are a mirror pair when, on most shapes, reflecting
 //! `a`'s centroid across a plane of the shape lands near `b`'s, relative to how far apart they
-//! are. Each shape uses its own plane, so the test needs no correspondence beyond the tuples.
+//! are, and the two look alike to the features a mirror image leaves unchanged ([`Likeness`]).
+//! Each shape uses its own plane, so the test needs no correspondence beyond the tuples.
 //!
 //! Entry points: [`mirror_plane`] (one mesh), [`mirror_pairs`] (a co-segmentation over its
 //! meshes, with each shape's plane or, for an aligned collection, vertical planes). The part tree merges mirror pairs before anything else
 //! ([`super::AdaptiveCosegmentation::regroup`]), so `--parts N` keeps the two sides of a part
 //! together.
 
-use super::Cosegmentation;
+use super::{Cosegmentation, ShapeGraph};
 use crate::mesh::TriMesh;
 use serde::Serialize;
 use std::collections::HashMap;
@@ -193,6 +194,9 @@ pub struct MirrorPair {
     /// Median over the same shapes of the smaller region's area over the larger's (1 for
     /// copies of one size).
     pub area_balance: f64,
+    /// Median over the shapes of the two regions' [`Likeness`] (`None`: not compared, no
+    /// mirror-invariant feature).
+    pub likeness: Option<f64>,
 }
 
 /// Mirror pairs are pairs whose median ratio is below this: the reflected centroid lands
@@ -203,6 +207,52 @@ pub const MIRROR_PAIR_RATIO: f64 = 1.0 / 3.0;
 /// out parts that merely sit opposite each other at one height (a quadruped's head and tail,
 /// about 2 : 1).
 pub const MIRROR_AREA_BALANCE: f64 = 2.0 / 3.0;
+
+/// Mirror pairs are pairs whose median likeness ([`Likeness`]) is at least this, when the
+/// likeness is known. Measured on the generated families (spectral features): left/right
+/// copies 0.62–0.90, a quadruped's head and tail 0.32–0.33 (docs/PARTS.md).
+pub const MIRROR_LIKENESS: f64 = 0.5;
+
+/// What two parts of one shape are compared on: the band tables of `graph` (the one the
+/// co-segmentation was found on), restricted to `columns`, features a mirror image leaves
+/// unchanged ([`crate::pipeline::ShapePipelineOptions::mirror_invariant_columns`]). The
+/// likeness of regions `a` and `b` is `1 − mean_k TV(h_a^k, h_b^k)`, `h^k` the area-weighted
+/// histogram of feature `k`'s bands over the region, TV the total variation distance: 1 for
+/// parts that look alike to intrinsic features (a left and a right arm), less for parts that
+/// merely sit opposite each other (a head and a tail).
+#[derive(Debug, Clone, Copy)]
+pub struct Likeness<'a> {
+    /// The shape graph (its nodes' band tables and areas, graph order).
+    pub graph: &'a ShapeGraph,
+    /// Mirror-invariant feature columns.
+    pub columns: &'a [usize],
+}
+
+impl Likeness<'_> {
+    /// The likeness of vertex sets `a` and `b` of shape `i` (module docs); `None` without
+    /// columns, for an empty region, or past the graph.
+    pub fn of(&self, i: usize, a: &[u32], b: &[u32]) -> Option<f64> {
+        if self.columns.is_empty() || i >= self.graph.node_count() {
+            return None;
+        }
+        let node = self.graph.node(i);
+        let t = &node.bands;
+        let hist = |r: &[u32], k: usize| -> Option<Vec<f64>> {
+            let mut h = vec![0.0; t.bands];
+            for &v in r {
+                h[t.label(v as usize, k) as usize] += node.areas[v as usize];
+            }
+            let total: f64 = h.iter().sum();
+            (total > 0.0).then(|| h.iter().map(|x| x / total).collect())
+        };
+        let mut tv = 0.0;
+        for &k in self.columns.iter().filter(|&&k| k < t.features) {
+            let (ha, hb) = (hist(a, k)?, hist(b, k)?);
+            tv += 0.5 * ha.iter().zip(&hb).map(|(x, y)| (x - y).abs()).sum::<f64>();
+        }
+        Some(1.0 - tv / self.columns.len() as f64)
+    }
+}
 
 /// The mirror pairs among the tuples of `coseg` (graph order; `meshes[i]` is shape `i`).
 ///
@@ -217,8 +267,14 @@ pub const MIRROR_AREA_BALANCE: f64 = 2.0 / 3.0;
 ///   at about the same height, at about the same distance on either side of the centroid.
 ///
 /// A shape takes part when both regions are non-empty on it; a pair needs at least half of
-/// all shapes to take part, a median ratio below [`MIRROR_PAIR_RATIO`] and a median area
-/// balance of at least [`MIRROR_AREA_BALANCE`]. Pairs are then matched greedily, lowest
+/// all shapes to take part, a median ratio below [`MIRROR_PAIR_RATIO`], a median area
+/// balance of at least [`MIRROR_AREA_BALANCE`] and, with `likeness` (and columns to compare
+/// on), a median [`Likeness`] of at least [`MIRROR_LIKENESS`].
+///
+/// Known issue: with `up` and no likeness the test only asks that two parts of one size sit
+/// opposite each other at one height, which a quadruped's head and tail do; the likeness rules
+/// them out (docs/PARTS.md). Copies exchanged by a half turn about the vertical (a front leg
+/// and the diagonal back leg) are pairs too. Pairs are then matched greedily, lowest
 /// ratio first, so a tuple is in at most one pair. Output sorted by ratio.
 ///
 /// Inputs: `meshes` (#shapes, #V_i vertices each), `coseg` (its regions index the meshes'
@@ -239,7 +295,7 @@ pub const MIRROR_AREA_BALANCE: f64 = 2.0 / 3.0;
 /// let coseg = Cosegmentation { names: vec!["s".into()], vertices: vec![10], root: 0, order: vec![0],
 ///     parent: vec![None], alpha: 0.25,
 ///     tuples: vec![tuple(vec![0, 1]), tuple(vec![2, 3, 4, 5, 6, 7]), tuple(vec![8, 9])] };
-/// let pairs = mirror_pairs(&[mesh], &coseg, Some([0.0, 1.0, 0.0]));
+/// let pairs = mirror_pairs(&[mesh], &coseg, Some([0.0, 1.0, 0.0]), None);
 /// assert_eq!((pairs.len(), pairs[0].a, pairs[0].b), (1, 0, 2));
 /// assert!(pairs[0].ratio < 1e-12);
 /// ```
@@ -247,6 +303,7 @@ pub fn mirror_pairs(
     meshes: &[TriMesh],
     coseg: &Cosegmentation,
     up: Option<[f64; 3]>,
+    likeness: Option<Likeness<'_>>,
 ) -> Vec<MirrorPair> {
     let up = up.and_then(unit);
     let n = coseg.names.len();
@@ -312,12 +369,25 @@ pub fn mirror_pairs(
                 continue;
             }
             let (ratio, area_balance) = (median(&mut ratios), median(&mut balances));
-            if ratio < MIRROR_PAIR_RATIO && area_balance >= MIRROR_AREA_BALANCE {
+            if ratio >= MIRROR_PAIR_RATIO || area_balance < MIRROR_AREA_BALANCE {
+                continue;
+            }
+            let mut alike: Vec<f64> = likeness
+                .iter()
+                .flat_map(|l| {
+                    (0..n).filter_map(move |i| {
+                        l.of(i, &coseg.tuples[a].regions[i], &coseg.tuples[b].regions[i])
+                    })
+                })
+                .collect();
+            let likeness = (!alike.is_empty()).then(|| median(&mut alike));
+            if likeness.is_none_or(|x| x >= MIRROR_LIKENESS) {
                 candidates.push(MirrorPair {
                     a,
                     b,
                     ratio,
                     area_balance,
+                    likeness,
                 });
             }
         }

@@ -39,7 +39,8 @@ pub use load_collection::{
     LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
 };
 pub use mirror_pairs::{
-    MIRROR_AREA_BALANCE, MIRROR_PAIR_RATIO, MirrorPair, MirrorPlane, mirror_pairs, mirror_plane,
+    Likeness, MIRROR_AREA_BALANCE, MIRROR_LIKENESS, MIRROR_PAIR_RATIO, MirrorPair, MirrorPlane,
+    mirror_pairs, mirror_plane,
 };
 pub use refine_cosegmentation::{
     MIN_KEPT_SHARE, RefineSizes, refine_cosegmentation, refine_cosegmentation_sized,

@@ -4,7 +4,7 @@
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    PartsReport, RefineSizes, adaptive_cosegment, cosegment, mirror_pairs,
+    Likeness, PartsReport, RefineSizes, adaptive_cosegment, cosegment, mirror_pairs,
     refine_cosegmentation_sized,
 };
 use crate::mesh::TriMesh;
@@ -62,6 +62,12 @@ pub struct SegmentCollectionOptions {
     /// Not serialised: the feature options that imply it are recorded with them.
     #[serde(skip)]
     pub up: Option<[f64; 3]>,
+    /// Feature columns a mirror image leaves unchanged
+    /// ([`crate::pipeline::ShapePipelineOptions::mirror_invariant_columns`]): mirror pairs
+    /// must look alike on them ([`super::Likeness`]). Empty (the default): not compared. Not
+    /// serialised, like [`Self::up`].
+    #[serde(skip)]
+    pub mirror_columns: Vec<usize>,
 }
 
 fn is_free(r: &RefineSizes) -> bool {
@@ -157,6 +163,7 @@ impl Default for SegmentCollectionOptions {
             refine_sizes: RefineSizes::Free,
             group_mirrors: false,
             up: None,
+            mirror_columns: Vec::new(),
         }
     }
 }
@@ -191,6 +198,8 @@ pub struct SegmentedCollection {
     pub start_scores: Vec<f64>,
     /// [`SegmentCollectionOptions::up`], for the mirror pairs of [`Self::parts_report`].
     pub up: Option<[f64; 3]>,
+    /// [`SegmentCollectionOptions::mirror_columns`], likewise.
+    pub mirror_columns: Vec<usize>,
 }
 
 impl SegmentedCollection {
@@ -198,9 +207,13 @@ impl SegmentedCollection {
     /// [`PartsReport`] of [`Self::adaptive`] for the final segmentation, its pieces counted on
     /// `meshes` (graph order; empty: no piece counts). `None` without `--parts`.
     pub fn parts_report(&self, meshes: &[TriMesh]) -> Option<PartsReport> {
-        self.adaptive
-            .as_ref()
-            .map(|a| PartsReport::new(a, &self.segmentation, meshes, self.up))
+        self.adaptive.as_ref().map(|a| {
+            let likeness = Likeness {
+                graph: &self.graph,
+                columns: &self.mirror_columns,
+            };
+            PartsReport::new(a, &self.segmentation, meshes, self.up, Some(likeness))
+        })
     }
 }
 
@@ -312,10 +325,18 @@ pub fn segment_collection(
             Some(p) => {
                 let mut a = adaptive_cosegment(&graph, p)?;
                 if options.group_mirrors {
-                    let pairs: Vec<(usize, usize)> = mirror_pairs(meshes, &a.leaves, options.up)
-                        .iter()
-                        .map(|m| (m.a, m.b))
-                        .collect();
+                    let pairs: Vec<(usize, usize)> = mirror_pairs(
+                        meshes,
+                        &a.leaves,
+                        options.up,
+                        Some(Likeness {
+                            graph: &graph,
+                            columns: &options.mirror_columns,
+                        }),
+                    )
+                    .iter()
+                    .map(|m| (m.a, m.b))
+                    .collect();
                     if !pairs.is_empty() {
                         a.regroup(&graph, &pairs);
                     }
@@ -350,5 +371,6 @@ pub fn segment_collection(
         start,
         start_scores,
         up: options.up,
+        mirror_columns: options.mirror_columns.clone(),
     })
 }

@@ -122,10 +122,39 @@ impl ShapePipelineOptions {
         }
     }
 
+    /// The columns of a feature table of `features` columns (made under these options) that a
+    /// mirror image leaves unchanged: the spectral descriptors and the shape diameter (`sdf`),
+    /// not the extrinsic heights and normals nor the user's columns (unknown). What the
+    /// mirror-pair test compares two parts on ([`crate::graph::Likeness`]).
+    ///
+    /// ```
+    /// use coseg::pipeline::ShapePipelineOptions;
+    /// let mut o = ShapePipelineOptions::default();
+    /// o.set_families("spectral,extrinsic", "y", 10, 0, "").unwrap();
+    /// // 300 spectral columns, then 10 heights + 2 distances.
+    /// assert_eq!(o.mirror_invariant_columns(312), (0..300).collect::<Vec<_>>());
+    /// o.set_families("extrinsic", "y", 10, 0, "").unwrap();
+    /// assert!(o.mirror_invariant_columns(12).is_empty());
+    /// ```
+    pub fn mirror_invariant_columns(&self, features: usize) -> Vec<usize> {
+        let [spectral, ext, sdf] = self.family_columns();
+        (0..spectral.min(features))
+            .chain((spectral + ext).min(features)..(spectral + ext + sdf).min(features))
+            .collect()
+    }
+
     /// Per-column affinity weights for a feature table of `features` columns made under these
     /// options ([`FeatureFamilies::feature_weights`]; the user family's count is what remains
     /// after the others). `None`: one family, equal weights.
     pub fn feature_weights(&self, features: usize) -> Option<Vec<f64>> {
+        let [spectral, ext, sdf] = self.family_columns();
+        let user = features.saturating_sub(spectral + ext + sdf);
+        self.families.feature_weights(spectral, [ext, sdf, user])
+    }
+
+    /// Column counts of the spectral, extrinsic and sdf families (in table order; the user's
+    /// columns come last and are what remains).
+    fn family_columns(&self) -> [usize; 3] {
         let d = &self.descriptors;
         let spectral = d.hks_count + d.wks_count + d.curvature_count;
         let f = &self.families;
@@ -136,8 +165,7 @@ impl ShapePipelineOptions {
                 + e.normal_directions
         });
         let sdf = f.sdf.as_ref().map_or(0, |s| s.smoothing_rounds.len());
-        let user = features.saturating_sub(spectral + ext + sdf);
-        f.feature_weights(spectral, [ext, sdf, user])
+        [spectral, ext, sdf]
     }
 }
 
