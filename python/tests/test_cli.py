@@ -133,6 +133,8 @@ def test_parts_starts_and_normals_match_the_cli(coseg_bin, chairs, tmp_path):
         assert_same_outputs(cli_out, py_out)
         if "parts" in opts:
             assert r["summary"]["parts"]["region_leaves"]
+            # Mirror pairs are compared on the spectral columns (a likeness) in both.
+            assert all(p["likeness"] is not None for p in r["summary"]["parts"]["mirror_pairs"])
             if opts["parts"] == 3:
                 assert len(r["summary"]["parts"]["region_leaves"]) == 3
                 assert r["summary"]["options"]["refine_sizes"] == {"rule": "keep", "tolerance": 0.3}
