@@ -457,8 +457,9 @@ def segment(
     leftovers; ``parts`` (None): parts of their own size instead of equal areas (Algorithm 3
     across the collection, docs/PARTS.md), ``"auto"`` for as many as are stable and
     consistent or an integer N to cut the tree of parts at N, ``regions`` then being the
-    upper bound (default 8) and ``summary["parts"]`` the thresholds, sizes, tree and mirror
-    candidates; ``starts`` (1): co-segment from this many starts and keep the one of highest
+    upper bound (default 8) and ``summary["parts"]`` the thresholds, sizes, tree, mirror
+    candidates (regions holding both sides) and mirror pairs (regions that are left/right
+    copies, ``mirror_pairs``); ``starts`` (1): co-segment from this many starts and keep the one of highest
     mean confidence (equal-area mode only: with ``parts`` it raises :class:`InputError`); ``refine_sizes`` (``"free"``): ``"keep"`` or
     ``"keep:TOL"`` keeps each part's area within a factor 1 + TOL (default 0.5) of its
     area before refinement (meant for ``parts``); ``area_fraction`` (None: 1 / regions) of

@@ -34,7 +34,8 @@ pub struct SegmentArgs {
     #[arg(long)]
     regions: Option<usize>,
     /// Parts of their own size (Algorithm 3 across the collection, see docs/PARTS.md): `auto`
-    /// = as many as are stable and consistent, `N` = cut the tree of parts at N. Without it,
+    /// = as many as are stable and consistent, `N` = cut the tree of parts at N. summary.json
+    /// then records the tree and the mirror pairs (left/right copies). Without it,
     /// `--regions` equal-area regions.
     #[arg(long, value_parser = parse_parts)]
     parts: Option<PartsRequest>,
