@@ -60,6 +60,28 @@ fn person(scale: f64, pose: f64) -> (TriMesh, Vec<Vec<u32>>) {
     ])
 }
 
+/// The meshes and the per-shape part vertex sets of `shapes`.
+fn split(shapes: Vec<(TriMesh, Vec<Vec<u32>>)>) -> (Vec<TriMesh>, Vec<Vec<Vec<u32>>>) {
+    shapes.into_iter().unzip()
+}
+
+/// Three shapes (scaled 1, 1.1, 0.9 along x): a body and two end blocks opposite each other
+/// along x at one height, the second block `half` thick in y and z (0.3: the first's size).
+fn blocks(half: f64) -> (Vec<TriMesh>, Vec<Vec<Vec<u32>>>) {
+    split(
+        [1.0, 1.1, 0.9]
+            .iter()
+            .map(|&s| {
+                figure(&[
+                    ([0.0, 0.0, 0.0], [1.0 * s, 0.5, 0.5]),
+                    ([1.5 * s, 0.0, 0.0], [0.3, 0.3, 0.3]),
+                    ([-1.5 * s, 0.0, 0.0], [0.3, half, half]),
+                ])
+            })
+            .collect(),
+    )
+}
+
 fn coseg_of(meshes: &[TriMesh], parts: &[Vec<Vec<u32>>]) -> Cosegmentation {
     let n = meshes.len();
     let tuples = (0..parts[0].len())
@@ -135,8 +157,7 @@ fn mirror_plane_of_a_posed_figure_reports_its_asymmetry() {
 fn mirror_pairs_are_the_left_and_right_parts() {
     let shapes: Vec<(TriMesh, Vec<Vec<u32>>)> =
         [1.0, 1.2, 0.9].iter().map(|&s| person(s, 0.0)).collect();
-    let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
-    let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
+    let (meshes, parts) = split(shapes);
     let coseg = coseg_of(&meshes, &parts);
     // Each shape's own plane, and vertical planes (up = +y): the arms and the legs.
     let by_plane = mirror_pairs(&meshes, &coseg, None, None);
@@ -158,8 +179,7 @@ fn mirror_pairs_of_posed_figures_need_the_up_direction() {
         .iter()
         .map(|&(s, p)| person(s, p))
         .collect();
-    let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
-    let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
+    let (meshes, parts) = split(shapes);
     let coseg = coseg_of(&meshes, &parts);
     let up = mirror_pairs(&meshes, &coseg, Some([0.0, 1.0, 0.0]), None);
     assert_eq!(pairs(&up), vec![(1, 2), (4, 5)]);
@@ -181,18 +201,7 @@ fn mirror_pairs_need_copies_of_one_size() {
     // A body with two blocks opposite each other at one height: paired when they have one
     // size, not when one has a third of the other's area (a head and a tail).
     let pair_of = |half: f64| {
-        let shapes: Vec<(TriMesh, Vec<Vec<u32>>)> = [1.0, 1.1, 0.9]
-            .iter()
-            .map(|&s| {
-                figure(&[
-                    ([0.0, 0.0, 0.0], [1.0 * s, 0.5, 0.5]),
-                    ([1.5 * s, 0.0, 0.0], [0.3, 0.3, 0.3]),
-                    ([-1.5 * s, 0.0, 0.0], [0.3, half, half]),
-                ])
-            })
-            .collect();
-        let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
-        let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
+        let (meshes, parts) = blocks(half);
         pairs(&mirror_pairs(
             &meshes,
             &coseg_of(&meshes, &parts),
@@ -235,18 +244,7 @@ fn mirror_pairs_must_look_alike_when_the_features_say_so() {
     // Torso and two end blocks of one size opposite each other (a head and a tail, or two
     // arms): a pair by position alone; with an intrinsic column that gives the blocks the
     // same band, still a pair (likeness 1); with different bands, none (likeness 0).
-    let shapes: Vec<(TriMesh, Vec<Vec<u32>>)> = [1.0, 1.1, 0.9]
-        .iter()
-        .map(|&s| {
-            figure(&[
-                ([0.0, 0.0, 0.0], [1.0 * s, 0.5, 0.5]),
-                ([1.5 * s, 0.0, 0.0], [0.3, 0.3, 0.3]),
-                ([-1.5 * s, 0.0, 0.0], [0.3, 0.3, 0.3]),
-            ])
-        })
-        .collect();
-    let meshes: Vec<TriMesh> = shapes.iter().map(|s| s.0.clone()).collect();
-    let parts: Vec<Vec<Vec<u32>>> = shapes.iter().map(|s| s.1.clone()).collect();
+    let (meshes, parts) = blocks(0.3);
     let coseg = coseg_of(&meshes, &parts);
     let up = Some([0.0, 0.0, 1.0]);
     let alike = graph_of(&meshes, &parts, &[0, 1, 1]);
