@@ -156,7 +156,7 @@ pub fn shape_frame(mesh: &TriMesh, alignment: Alignment) -> Frame {
 }
 
 /// Area centroid, area-weighted covariance (vertex areas) and the vertex areas.
-fn surface_moments(mesh: &TriMesh) -> ([f64; 3], [[f64; 3]; 3], Vec<f64>) {
+pub(crate) fn surface_moments(mesh: &TriMesh) -> ([f64; 3], [[f64; 3]; 3], Vec<f64>) {
     let w = mesh.vertex_areas();
     let total: f64 = w.iter().sum();
     let mut c = [0.0; 3];

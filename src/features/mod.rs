@@ -31,6 +31,7 @@ mod wave_kernel_signature;
 
 pub use columns::FeatureColumns;
 pub use descriptors::{DescriptorOptions, Descriptors, FeatureKind, descriptors};
+pub(crate) use extrinsic::surface_moments;
 pub use extrinsic::{
     Alignment, Axis, ExtrinsicOptions, Frame, extrinsic_features, fixed_value_range,
     height_directions, shape_frame,

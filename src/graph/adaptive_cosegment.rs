@@ -626,7 +626,8 @@ fn check(graph: &ShapeGraph, o: &AdaptiveOptions) -> Result<(), GraphError> {
     Ok(())
 }
 
-fn median(v: &[f64]) -> f64 {
+/// The median of `v` (the mean of the middle two for an even length).
+pub(super) fn median(v: &[f64]) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
     let m = s.len() / 2;

@@ -13,6 +13,7 @@
 //! ([`super::AdaptiveCosegmentation::regroup`]), so `--parts N` keeps the two sides of a part
 //! together.
 
+use super::adaptive_cosegment::median;
 use super::{Cosegmentation, ShapeGraph};
 use crate::mesh::TriMesh;
 use serde::Serialize;
@@ -82,30 +83,17 @@ impl MirrorPlane {
 /// assert!(plane.normal[0].abs() > 0.999 && (plane.point[0] - 1.0).abs() < 1e-12);
 /// ```
 pub fn mirror_plane(mesh: &TriMesh) -> Option<MirrorPlane> {
+    let Moments {
+        centroid: c,
+        cov,
+        areas: w,
+        radius,
+    } = moments(mesh)?;
     let pos = mesh.positions();
-    let w = mesh.vertex_areas();
     let total: f64 = w.iter().sum();
-    if total.is_nan() || total <= 0.0 || pos.is_empty() {
-        return None;
-    }
-    let mut c = [0.0; 3];
-    for (p, &a) in pos.iter().zip(&w) {
-        (0..3).for_each(|k| c[k] += a * p[k]);
-    }
-    c.iter_mut().for_each(|x| *x /= total);
-    let mut cov = nalgebra::Matrix3::<f64>::zeros();
-    for (p, &a) in pos.iter().zip(&w) {
-        let q = nalgebra::Vector3::new(p[0] - c[0], p[1] - c[1], p[2] - c[2]);
-        cov += a * q * q.transpose();
-    }
-    cov /= total;
-    let radius = cov.trace().sqrt();
-    if radius.is_nan() || radius <= 0.0 {
-        return None;
-    }
     let cap = MirrorPlane::DISTANCE_CAP * radius;
     let grid = Grid::new(pos, cap / 4.0);
-    let eig = nalgebra::SymmetricEigen::new(cov);
+    let eig = nalgebra::SymmetricEigen::new(nalgebra::Matrix3::from_fn(|i, j| cov[i][j]));
     let mut order = [0usize, 1, 2];
     // Largest variance first, so that ties between equal errors pick a stable axis.
     order.sort_by(|&a, &b| eig.eigenvalues[b].total_cmp(&eig.eigenvalues[a]));
@@ -127,6 +115,33 @@ pub fn mirror_plane(mesh: &TriMesh) -> Option<MirrorPlane> {
             plane
         })
         .min_by(|a, b| a.error.total_cmp(&b.error))
+}
+
+/// A surface's moments ([`crate::features::surface_moments`]) and its RMS radius.
+struct Moments {
+    centroid: [f64; 3],
+    cov: [[f64; 3]; 3],
+    areas: Vec<f64>,
+    radius: f64,
+}
+
+/// The moments of `mesh`; `None` for a mesh without area or extent.
+fn moments(mesh: &TriMesh) -> Option<Moments> {
+    let (centroid, cov, areas) = crate::features::surface_moments(mesh);
+    let total: f64 = areas.iter().sum();
+    if total.is_nan() || total <= 0.0 || areas.is_empty() {
+        return None;
+    }
+    let radius = (cov[0][0] + cov[1][1] + cov[2][2]).sqrt();
+    if radius.is_nan() || radius <= 0.0 {
+        return None;
+    }
+    Some(Moments {
+        centroid,
+        cov,
+        areas,
+        radius,
+    })
 }
 
 /// Uniform grid over the vertices for capped nearest-vertex queries.
@@ -269,13 +284,13 @@ impl Likeness<'_> {
 /// A shape takes part when both regions are non-empty on it; a pair needs at least half of
 /// all shapes to take part, a median ratio below [`MIRROR_PAIR_RATIO`], a median area
 /// balance of at least [`MIRROR_AREA_BALANCE`] and, with `likeness` (and columns to compare
-/// on), a median [`Likeness`] of at least [`MIRROR_LIKENESS`].
+/// on), a median [`Likeness`] of at least [`MIRROR_LIKENESS`]. Pairs are then matched
+/// greedily, lowest ratio first, so a tuple is in at most one pair. Output sorted by ratio.
 ///
 /// Known issue: with `up` and no likeness the test only asks that two parts of one size sit
 /// opposite each other at one height, which a quadruped's head and tail do; the likeness rules
 /// them out (docs/PARTS.md). Copies exchanged by a half turn about the vertical (a front leg
-/// and the diagonal back leg) are pairs too. Pairs are then matched greedily, lowest
-/// ratio first, so a tuple is in at most one pair. Output sorted by ratio.
+/// and the diagonal back leg) are pairs too.
 ///
 /// Inputs: `meshes` (#shapes, #V_i vertices each), `coseg` (its regions index the meshes'
 /// vertices). Empty when the meshes do not match `coseg`. See also
@@ -321,12 +336,21 @@ pub fn mirror_pairs(
         .iter()
         .enumerate()
         .map(|(i, mesh)| {
-            let plane = match up {
-                // Only the centroid is used: each pair gets its own vertical plane.
-                Some(_) => mirror_plane(mesh)?,
-                None => mirror_plane(mesh).filter(|p| p.error <= MirrorPlane::MAX_ERROR)?,
+            let (reflection, w) = match up {
+                // Each pair gets its own vertical plane through the centroid: no global plane
+                // (and no reflection error) is needed.
+                Some(up) => {
+                    let m = moments(mesh)?;
+                    let point = m.centroid;
+                    (Reflection::Vertical { point, up }, m.areas)
+                }
+                None => (
+                    Reflection::Plane(
+                        mirror_plane(mesh).filter(|p| p.error <= MirrorPlane::MAX_ERROR)?,
+                    ),
+                    mesh.vertex_areas(),
+                ),
             };
-            let w = mesh.vertex_areas();
             let pos = mesh.positions();
             let centroids = coseg
                 .tuples
@@ -343,24 +367,24 @@ pub fn mirror_pairs(
                     })
                 })
                 .collect();
-            Some((plane, centroids))
+            Some((reflection, centroids))
         })
         .collect();
     let mut candidates = Vec::new();
     for a in 0..l {
         for b in a + 1..l {
-            let (mut ratios, mut balances): (Vec<f64>, Vec<f64>) = shapes
+            let (ratios, balances): (Vec<f64>, Vec<f64>) = shapes
                 .iter()
                 .flatten()
-                .filter_map(|(plane, c)| {
+                .filter_map(|(reflection, c)| {
                     let ((ca, wa), (cb, wb)) = (c[a]?, c[b]?);
                     let apart = dist(ca, cb);
                     if apart.is_nan() || apart <= 0.0 {
                         return None;
                     }
-                    let plane = match up {
-                        Some(u) => vertical_plane(plane.point, u, ca, cb)?,
-                        None => *plane,
+                    let plane = match *reflection {
+                        Reflection::Vertical { point, up } => vertical_plane(point, up, ca, cb)?,
+                        Reflection::Plane(plane) => plane,
                     };
                     Some((dist(plane.reflect(ca), cb) / apart, wa.min(wb) / wa.max(wb)))
                 })
@@ -368,11 +392,11 @@ pub fn mirror_pairs(
             if 2 * ratios.len() < n || ratios.is_empty() {
                 continue;
             }
-            let (ratio, area_balance) = (median(&mut ratios), median(&mut balances));
+            let (ratio, area_balance) = (median(&ratios), median(&balances));
             if ratio >= MIRROR_PAIR_RATIO || area_balance < MIRROR_AREA_BALANCE {
                 continue;
             }
-            let mut alike: Vec<f64> = likeness
+            let alike: Vec<f64> = likeness
                 .iter()
                 .flat_map(|l| {
                     (0..n).filter_map(move |i| {
@@ -380,7 +404,7 @@ pub fn mirror_pairs(
                     })
                 })
                 .collect();
-            let likeness = (!alike.is_empty()).then(|| median(&mut alike));
+            let likeness = (!alike.is_empty()).then(|| median(&alike));
             if likeness.is_none_or(|x| x >= MIRROR_LIKENESS) {
                 candidates.push(MirrorPair {
                     a,
@@ -432,18 +456,16 @@ fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
         .then(|| v.map(|x| x / len))
 }
 
-/// A shape's plane and each tuple's area centroid and area on it (`None`: empty there).
-type ShapeCentroids = (MirrorPlane, Vec<Option<([f64; 3], f64)>>);
-
-fn median(v: &mut [f64]) -> f64 {
-    v.sort_by(f64::total_cmp);
-    let m = v.len();
-    if m % 2 == 1 {
-        v[m / 2]
-    } else {
-        0.5 * (v[m / 2 - 1] + v[m / 2])
-    }
+/// How a shape's regions are reflected: across its own plane, or (aligned collections) across
+/// the vertical plane through its centroid chosen per pair ([`vertical_plane`]).
+#[derive(Clone, Copy)]
+enum Reflection {
+    Plane(MirrorPlane),
+    Vertical { point: [f64; 3], up: [f64; 3] },
 }
+
+/// A shape's reflection and each tuple's area centroid and area on it (`None`: empty there).
+type ShapeCentroids = (Reflection, Vec<Option<([f64; 3], f64)>>);
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
     (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
