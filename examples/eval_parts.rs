@@ -2,13 +2,16 @@
 //!
 //! ```text
 //! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N]
-//!     [--features F --up AXIS [--normals N]] [--starts N] [--keep-sizes TOL] [--detail] MODE...
+//!     [--features F --up AXIS [--normals N]] [--starts N] [--keep-sizes TOL] [--detail]
+//!     [--parts-from adaptive|thickness] MODE...
 //! ```
 //! `--features`/`--up`/`--normals` select the feature families as `coseg segment` does (e.g.
 //! `--features spectral,extrinsic --up y --normals 16`), `--starts` its several starts, `--keep-sizes TOL`
 //! the size-aware refinement (`RefineSizes::Keep`, `coseg segment --refine-sizes keep:TOL`;
-//! without it the free best response). `--detail` prints, for families, each shape's own
-//! purity / coverage and the pooled area table (region × grouped part, % of a shape).
+//! without it the free best response), `--parts-from` where `parts:N` takes its finest parts
+//! (`coseg segment --parts-from`; with `thickness`, `@max=R` is the number of regions).
+//! `--detail` prints, for families, each shape's own purity / coverage, the pooled area table
+//! (region × grouped part, % of a shape) and the best any grouping of the regions could score.
 //! `FOLDER` is either a COSEG-style set (`shapes/N.off` and `gt/N.seg`, one label per face) or a
 //! shipped family (`collections/<family>`, per-vertex labels and a manifest). Each `MODE` is
 //! `fixed:R` (`cosegment`, R equal-area regions, today's `coseg segment --regions R`), `auto`
@@ -20,8 +23,8 @@
 
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
 use coseg::graph::{
-    AdaptiveOptions, Cosegmentation, LoadedCollection, SegmentCollectionOptions, load_collection,
-    segment_collection,
+    AdaptiveOptions, Cosegmentation, LoadedCollection, PartsFrom, SegmentCollectionOptions,
+    load_collection, segment_collection,
 };
 use coseg::pipeline::ShapePipelineOptions;
 use std::path::{Path, PathBuf};
@@ -135,6 +138,31 @@ fn family_scores(
             let cells: Vec<String> = row.iter().map(|x| format!("{:5.1}", 100.0 * x)).collect();
             eprintln!("  region {r}: {}", cells.join(" "));
         }
+        // Each region joined to its majority part: the best any grouping of these regions
+        // can do (the bound a part tree works towards).
+        let major: Vec<i32> = conf
+            .iter()
+            .map(|row| {
+                (0..parts)
+                    .max_by(|&x, &y| row[x].total_cmp(&row[y]))
+                    .unwrap_or(0) as i32
+            })
+            .collect();
+        let grouped: Vec<ShapeParts> = shapes
+            .iter()
+            .map(|s| {
+                let f = s
+                    .found
+                    .iter()
+                    .map(|&f| if f >= 0 { major[f as usize] } else { f });
+                ShapeParts::new(s.areas.clone(), s.truth.clone(), f.collect())
+            })
+            .collect::<Result<_, _>>()?;
+        eprintln!(
+            "  best grouping of these regions: purity {:.2} % coverage {:.2} %",
+            100.0 * part_purity(&grouped)?,
+            100.0 * part_coverage(&grouped)?
+        );
     }
     Ok((part_purity(&shapes)?, part_coverage(&shapes)?))
 }
@@ -229,6 +257,7 @@ fn main() -> Res<()> {
     let mut detail = false;
     let mut normals = 0;
     let mut mirrors = false;
+    let mut parts_from = None;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--features" => features = args.next().ok_or("--features F")?,
@@ -237,6 +266,13 @@ fn main() -> Res<()> {
             "--starts" => starts = args.next().ok_or("--starts N")?.parse()?,
             "--detail" => detail = true,
             "--group-mirrors" => mirrors = true,
+            "--parts-from" => {
+                parts_from = Some(
+                    args.next()
+                        .ok_or("--parts-from KIND")?
+                        .parse::<PartsFrom>()?,
+                )
+            }
             "--keep-sizes" => keep = Some(args.next().ok_or("--keep-sizes TOL")?.parse()?),
             "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),
             "--refine-rounds" => refine_rounds = args.next().ok_or("--refine-rounds N")?.parse()?,
@@ -270,6 +306,13 @@ fn main() -> Res<()> {
         let mut o = options(mode, refine_rounds, starts)?;
         o.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
         o.group_mirrors = mirrors;
+        if let (Some(from), Some(_)) = (parts_from, &o.parts) {
+            let leaves = mode
+                .split_once("@max=")
+                .map(|(_, m)| m.parse())
+                .transpose()?;
+            o.set_parts_from(from, leaves);
+        }
         o.up = pipeline.up_direction();
         o.mirror_columns = pipeline.mirror_invariant_columns(loaded.nodes[0].bands.features);
         if let Some(tolerance) = keep {

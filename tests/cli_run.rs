@@ -229,6 +229,70 @@ fn refine_sizes_is_recorded_and_checked() {
     }
 }
 
+/// `--parts N --parts-from thickness`: N parts cut from `--regions` equal-area regions,
+/// recorded in summary.json (the option, the stop reason, the leaves); `--parts auto` and no
+/// `--parts` are refused with a message, as is an unknown kind.
+#[test]
+fn parts_from_thickness_is_recorded_and_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let input = dir.path().join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, 3, 2);
+    let run_with = |name: &str, extra: &[&str]| {
+        let out = dir.path().join(name);
+        let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
+        // FAST without its `--regions 3`: the regions are set here.
+        args.extend(&FAST[..FAST.len() - 2]);
+        args.extend(extra);
+        (coseg(&args), out)
+    };
+    let (run, out) = run_with(
+        "t",
+        &[
+            "--parts",
+            "2",
+            "--parts-from",
+            "thickness",
+            "--regions",
+            "5",
+        ],
+    );
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(
+        summary["options"]["parts_from"],
+        serde_json::json!({"kind": "thickness", "leaves": 5})
+    );
+    assert_eq!(summary["parts"]["stop"]["reason"], "equal_area_leaves");
+    assert_eq!(summary["parts"]["leaf_areas"].as_array().unwrap().len(), 5);
+    assert_eq!(
+        summary["parts"]["region_leaves"].as_array().unwrap().len(),
+        2
+    );
+    assert_eq!(summary["regions"].as_array().unwrap().len(), 2);
+    for (name, extra) in [
+        (
+            "auto",
+            &["--parts", "auto", "--parts-from", "thickness"][..],
+        ),
+        ("noparts", &["--parts-from", "thickness"][..]),
+    ] {
+        let (run, _) = run_with(name, extra);
+        assert_ne!(run.status.code(), Some(0), "{name}");
+        assert!(
+            text(&run.stderr).contains("number of parts"),
+            "{name}: {}",
+            text(&run.stderr)
+        );
+    }
+    let (run, _) = run_with(
+        "bad",
+        &["--parts", "2", "--parts-from", "size", "--regions", "5"],
+    );
+    assert_eq!(run.status.code(), Some(2), "{}", text(&run.stderr));
+}
+
 /// Regression: `--parts auto --starts 3` ran one start and said nothing; several starts are
 /// for the equal-area mode, so the combination is now an error that names `starts`.
 #[test]

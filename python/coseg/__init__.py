@@ -424,6 +424,7 @@ def segment(
     parts: Optional[Union[str, int]] = None,
     starts: int = _D["starts"],
     refine_sizes: str = _D["refine_sizes"],
+    parts_from: str = _D["parts_from"],
     area_fraction: Optional[float] = _D["area_fraction"],
     seed: Optional[int] = _D["segment_seed"],
     complete_limit: int = _D["complete_limit"],
@@ -462,7 +463,10 @@ def segment(
     copies, ``mirror_pairs``); ``starts`` (1): co-segment from this many starts and keep the one of highest
     mean confidence (equal-area mode only: with ``parts`` it raises :class:`InputError`); ``refine_sizes`` (``"free"``): ``"keep"`` or
     ``"keep:TOL"`` keeps each part's area within a factor 1 + TOL (default 0.5) of its
-    area before refinement (meant for ``parts``); ``area_fraction`` (None: 1 / regions) of
+    area before refinement (meant for ``parts``); ``parts_from`` (``"adaptive"``): with
+    ``parts=N``, ``"thickness"`` takes ``regions`` (default 12) equal-area regions and groups
+    touching ones (and left/right copies) of one thickness (``--parts-from thickness``,
+    docs/PARTS.md); ``area_fraction`` (None: 1 / regions) of
     each region; ``seed`` (None: start from the most distinctive vertex); ``complete_limit``
     (12): collections up to this size use a complete shape graph, larger ones ``neighbours``
     (6) nearest neighbours; ``refine_rounds`` (boundary refinement sweeps, 0 = none) and
@@ -479,6 +483,7 @@ def segment(
         parts=None if parts is None else str(parts),
         starts=starts,
         refine_sizes=refine_sizes,
+        parts_from=parts_from,
         area_fraction=area_fraction,
         seed=seed,
         complete_limit=complete_limit,

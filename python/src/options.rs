@@ -8,7 +8,8 @@ use coseg::features::{
     parse_family_weights,
 };
 use coseg::graph::{
-    CosegmentOptions, GraphError, GraphOptions, PartsRequest, RefineSizes, SegmentCollectionOptions,
+    CosegmentOptions, GraphError, GraphOptions, PartsFrom, PartsRequest, RefineSizes,
+    SegmentCollectionOptions,
 };
 use coseg::maps::{MapGuidedOptions, MapOverrides, MapPreset, MapStep, ZoomOutOptions};
 use coseg::pipeline::ShapePipelineOptions;
@@ -184,6 +185,7 @@ impl<'py> Opts<'py> {
         let parts: Option<String> = self.take("parts")?;
         let starts: Option<usize> = self.take("starts")?;
         let sizes: Option<String> = self.take("refine_sizes")?;
+        let from: Option<String> = self.take("parts_from")?;
         let lib = |e: GraphError| super::lib_err(&e);
         let mut o2 = d;
         if let Some(v) = upper_bound {
@@ -205,6 +207,9 @@ impl<'py> Opts<'py> {
         }
         if let Some(p) = parts {
             o2.request_parts(p.parse::<PartsRequest>().map_err(lib)?, upper_bound);
+        }
+        if let Some(f) = from {
+            o2.set_parts_from(f.parse::<PartsFrom>().map_err(lib)?, upper_bound);
         }
         Ok(o2)
     }
@@ -348,6 +353,7 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("segment_smoothing_time", refine.smoothing_time)?;
     d.set_item("starts", s.starts)?;
     d.set_item("refine_sizes", "free")?;
+    d.set_item("parts_from", "adaptive")?;
     let a = coseg::graph::AdaptiveOptions::default();
     d.set_item("max_parts", a.max_parts)?;
     let r = StableRegionsOptions::default();

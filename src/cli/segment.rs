@@ -4,8 +4,9 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{
-    CosegmentOptions, GraphError, GraphOptions, LoadedCollection, PartsRequest, RefineSizes,
-    SegmentCollectionOptions, SegmentedCollection, load_collection, segment_collection,
+    CosegmentOptions, GraphError, GraphOptions, LoadedCollection, PartsFrom, PartsRequest,
+    RefineSizes, SegmentCollectionOptions, SegmentedCollection, load_collection,
+    segment_collection,
 };
 use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
 use coseg::pipeline::ShapePipelineOptions;
@@ -30,7 +31,8 @@ pub struct SegmentArgs {
     #[arg(long)]
     cache: Option<PathBuf>,
     /// Regions per shape, the last being the leftovers (default 6); with `--parts`, the upper
-    /// bound on the number of parts (default 8).
+    /// bound on the number of parts (default 8); with `--parts-from thickness`, the number of
+    /// equal-area regions grouped into parts (default 12).
     #[arg(long)]
     regions: Option<usize>,
     /// Parts of their own size (Algorithm 3 across the collection, see docs/PARTS.md): `auto`
@@ -39,6 +41,12 @@ pub struct SegmentArgs {
     /// `--regions` equal-area regions.
     #[arg(long, value_parser = parse_parts)]
     parts: Option<PartsRequest>,
+    /// With `--parts N`, where the finest parts come from: `adaptive` (default; tuples of their
+    /// own size, grouped by what the affinity transports) or `thickness` (`--regions`
+    /// equal-area regions, default 12, and touching ones or left/right copies of one
+    /// thickness grouped first; best measured on the generated families, docs/PARTS.md).
+    #[arg(long, value_parser = parse_parts_from)]
+    parts_from: Option<PartsFrom>,
     /// Area of each region as a fraction of its shape (default: 1 / regions).
     #[arg(long)]
     area_fraction: Option<f64>,
@@ -78,6 +86,11 @@ pub struct SegmentArgs {
 
 /// `--refine-sizes free|keep[:TOL]`.
 fn parse_refine_sizes(s: &str) -> Result<RefineSizes, String> {
+    s.parse().map_err(|e: GraphError| e.to_string())
+}
+
+/// `--parts-from adaptive|thickness`.
+fn parse_parts_from(s: &str) -> Result<PartsFrom, String> {
     s.parse().map_err(|e: GraphError| e.to_string())
 }
 
@@ -225,6 +238,9 @@ fn collection_options(
     o2.mirror_columns = pipeline.mirror_invariant_columns(loaded.nodes[0].bands.features);
     if let Some(p) = args.parts {
         o2.request_parts(p, args.regions);
+    }
+    if let Some(from) = args.parts_from {
+        o2.set_parts_from(from, args.regions);
     }
     o2
 }

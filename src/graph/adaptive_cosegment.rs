@@ -167,6 +167,9 @@ pub enum StopReason {
         /// The rejected tuple's median area fraction.
         area: f64,
     },
+    /// Nothing was extracted: the leaves are equal-area regions grouped by thickness
+    /// ([`super::PartsFrom::Thickness`]).
+    EqualAreaLeaves,
 }
 
 impl std::fmt::Display for StopReason {
@@ -190,6 +193,10 @@ impl std::fmt::Display for StopReason {
             Self::NotSeparated { separation } => write!(
                 f,
                 "the next tuple's scores separated it from the rest by η = {separation:.3}, below the level"
+            ),
+            Self::EqualAreaLeaves => write!(
+                f,
+                "the finest parts are equal-area regions, grouped by thickness"
             ),
             Self::TooSmall { area } => write!(
                 f,
@@ -1153,7 +1160,11 @@ impl PartsReport {
     /// assert_eq!(PartsReport::new(&a, &a.leaves, &[], None, None).warning(), None);
     /// ```
     pub fn warning(&self) -> Option<String> {
-        (self.leaf_areas.len() == 1 && self.stop != StopReason::MaxParts).then(|| {
+        let asked = matches!(
+            self.stop,
+            StopReason::MaxParts | StopReason::EqualAreaLeaves
+        );
+        (self.leaf_areas.len() == 1 && !asked).then(|| {
             format!(
                 "parts of their own size: one part for the whole collection, since {}; \
                  ask for a number of parts (--parts N) or try other features (docs/PARTS.md)",
@@ -1195,12 +1206,7 @@ impl PartsReport {
             let g = region_leaves.remove(p);
             region_leaves.push(g);
         }
-        let pieces = (meshes.len() == fin.names.len()
-            && meshes
-                .iter()
-                .zip(&fin.vertices)
-                .all(|(m, &d)| m.vertex_count() == d))
-        .then(|| {
+        let pieces = fin.matches(meshes).then(|| {
             (0..fin.tuples.len())
                 .map(|r| {
                     let counts: Vec<f64> = meshes

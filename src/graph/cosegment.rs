@@ -150,6 +150,16 @@ pub struct Cosegmentation {
 }
 
 impl Cosegmentation {
+    /// Whether `meshes` are this co-segmentation's shapes: one per shape, in graph order, each
+    /// with the shape's vertex count (what its regions index).
+    pub fn matches(&self, meshes: &[crate::mesh::TriMesh]) -> bool {
+        meshes.len() == self.names.len()
+            && meshes
+                .iter()
+                .zip(&self.vertices)
+                .all(|(m, &d)| m.vertex_count() == d)
+    }
+
     /// Region id of every vertex of shape `i` (`-1` for a vertex in no region, which does not
     /// happen once the leftovers are assigned).
     pub fn labels(&self, i: usize) -> Vec<i32> {

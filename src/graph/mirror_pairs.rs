@@ -322,12 +322,7 @@ pub fn mirror_pairs(
 ) -> Vec<MirrorPair> {
     let up = up.and_then(unit);
     let n = coseg.names.len();
-    if meshes.len() != n
-        || meshes
-            .iter()
-            .zip(&coseg.vertices)
-            .any(|(m, &d)| m.vertex_count() != d)
-    {
+    if !coseg.matches(meshes) {
         return Vec::new();
     }
     let l = coseg.tuples.len();

@@ -13,6 +13,8 @@
 //!   (Algorithm 3 across the graph), the number of parts from the data and a tree of parts.
 //! - [`mirror_pairs`]: which tuples are left/right copies of each other (each shape's own
 //!   plane of mirror symmetry, [`mirror_plane`]); the part tree merges them first.
+//! - [`thickness_tree`]: a part tree over equal-area regions that merges touching regions
+//!   (and mirror pairs) of one thickness (`--parts N --parts-from thickness`).
 //! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
 //!   boundaries over every edge of the graph.
 //! - [`segment_collection`]: graph, co-segmentation and refinement in one call, as
@@ -28,6 +30,7 @@ mod refine_cosegmentation;
 mod segment_collection;
 mod shape_graph;
 mod stable_cycle;
+mod thickness_tree;
 
 pub use adaptive_cosegment::{
     AdaptiveCosegmentation, AdaptiveOptions, AutoTuple, PartMerge, PartTree, PartsReport, Sizing,
@@ -46,13 +49,14 @@ pub use refine_cosegmentation::{
     MIN_KEPT_SHARE, RefineSizes, refine_cosegmentation, refine_cosegmentation_sized,
 };
 pub use segment_collection::{
-    PartsRequest, SegmentCollectionOptions, SegmentTimes, SegmentedCollection, segment_collection,
-    start_score,
+    PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentTimes, SegmentedCollection,
+    segment_collection, start_score,
 };
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
 };
+pub use thickness_tree::thickness_tree;
 
 use crate::affinity::AffinityError;
 use thiserror::Error;
@@ -82,6 +86,16 @@ pub enum GraphError {
         /// The spectral-stage error.
         #[source]
         source: crate::spectral::SpectralError,
+    },
+    /// A shape's thickness (shape diameter function) for [`thickness_tree`] could not be
+    /// computed.
+    #[error("shape {name}: thickness (SDF): {source}")]
+    Thickness {
+        /// The shape's name.
+        name: String,
+        /// The feature-stage error.
+        #[source]
+        source: crate::features::FeatureError,
     },
     /// The collection folder could not be listed.
     #[error("{path}: {source}")]

@@ -4,8 +4,8 @@
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    Likeness, PartsReport, RefineSizes, adaptive_cosegment, cosegment, mirror_pairs,
-    refine_cosegmentation_sized,
+    Likeness, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment, mirror_pairs,
+    refine_cosegmentation_sized, thickness_tree,
 };
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -68,6 +68,64 @@ pub struct SegmentCollectionOptions {
     /// serialised, like [`Self::up`].
     #[serde(skip)]
     pub mirror_columns: Vec<usize>,
+    /// With [`Self::parts`] and a number of parts ([`AdaptiveOptions::parts`]): where the
+    /// finest parts come from and how they are grouped (default [`PartsFrom::Adaptive`]).
+    #[serde(skip_serializing_if = "PartsFrom::is_adaptive")]
+    pub parts_from: PartsFrom,
+}
+
+/// Where `--parts N` takes its finest parts from, and how it groups them
+/// (`coseg segment --parts-from adaptive|thickness`; measured side by side in docs/PARTS.md).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum PartsFrom {
+    /// Tuples of their own size ([`adaptive_cosegment`]), grouped by what the affinity
+    /// transports between them ([`AdaptiveCosegmentation::regroup`]); refined after the cut.
+    #[default]
+    Adaptive,
+    /// `leaves` equal-area regions ([`cosegment`], refined), grouped by
+    /// [`super::thickness_tree`]: touching regions (and mirror pairs) of one thickness merge
+    /// first. Needs the meshes and a number of parts; no refinement after the cut (it would
+    /// drift the grouped parts back towards equal areas).
+    Thickness {
+        /// Number of equal-area regions (the finest parts; `coseg segment --regions`,
+        /// default [`PartsFrom::THICKNESS_LEAVES`]).
+        leaves: usize,
+    },
+}
+
+impl PartsFrom {
+    /// The default number of leaves of [`PartsFrom::Thickness`]: enough that each region lies
+    /// mostly in one part of a body or a chair (measured: 84–92 % of their area on the
+    /// generated families), few enough that each is a sizeable piece of a part.
+    pub const THICKNESS_LEAVES: usize = 12;
+
+    fn is_adaptive(&self) -> bool {
+        *self == Self::Adaptive
+    }
+}
+
+impl std::str::FromStr for PartsFrom {
+    type Err = GraphError;
+
+    /// `adaptive` or `thickness` (with [`PartsFrom::THICKNESS_LEAVES`] leaves).
+    ///
+    /// ```
+    /// use coseg::graph::PartsFrom;
+    /// assert_eq!("thickness".parse::<PartsFrom>().unwrap(), PartsFrom::Thickness { leaves: 12 });
+    /// assert!("size".parse::<PartsFrom>().is_err());
+    /// ```
+    fn from_str(s: &str) -> Result<Self, GraphError> {
+        match s {
+            "adaptive" => Ok(Self::Adaptive),
+            "thickness" => Ok(Self::Thickness {
+                leaves: Self::THICKNESS_LEAVES,
+            }),
+            _ => Err(GraphError::BadOption(format!(
+                "{s:?}: expected `adaptive` or `thickness`"
+            ))),
+        }
+    }
 }
 
 fn is_free(r: &RefineSizes) -> bool {
@@ -151,6 +209,24 @@ impl SegmentCollectionOptions {
     }
 }
 
+impl SegmentCollectionOptions {
+    /// Sets [`Self::parts_from`]; `regions` (`coseg segment --regions`), when given, is the
+    /// number of leaves of [`PartsFrom::Thickness`].
+    ///
+    /// ```
+    /// use coseg::graph::{PartsFrom, SegmentCollectionOptions};
+    /// let mut o = SegmentCollectionOptions::default();
+    /// o.set_parts_from(PartsFrom::Thickness { leaves: 12 }, Some(16));
+    /// assert_eq!(o.parts_from, PartsFrom::Thickness { leaves: 16 });
+    /// ```
+    pub fn set_parts_from(&mut self, from: PartsFrom, regions: Option<usize>) {
+        self.parts_from = match (from, regions) {
+            (PartsFrom::Thickness { .. }, Some(leaves)) => PartsFrom::Thickness { leaves },
+            (f, _) => f,
+        };
+    }
+}
+
 impl Default for SegmentCollectionOptions {
     fn default() -> Self {
         Self {
@@ -164,6 +240,7 @@ impl Default for SegmentCollectionOptions {
             group_mirrors: false,
             up: None,
             mirror_columns: Vec::new(),
+            parts_from: PartsFrom::Adaptive,
         }
     }
 }
@@ -230,6 +307,24 @@ pub fn start_score(segmentation: &Cosegmentation) -> f64 {
     t.iter().map(|x| x.confidence).sum::<f64>() / t.len() as f64
 }
 
+/// The mirror pairs among `coseg`'s tuples as leaf pairs, under `options`' up direction and
+/// mirror-invariant columns.
+fn mirror_links(
+    graph: &ShapeGraph,
+    meshes: &[TriMesh],
+    coseg: &Cosegmentation,
+    options: &SegmentCollectionOptions,
+) -> Vec<(usize, usize)> {
+    let likeness = Likeness {
+        graph,
+        columns: &options.mirror_columns,
+    };
+    mirror_pairs(meshes, coseg, options.up, Some(likeness))
+        .iter()
+        .map(|m| (m.a, m.b))
+        .collect()
+}
+
 /// Co-segments a collection: builds the shape graph over `nodes`, extracts consistent region
 /// tuples with [`cosegment`], and (by default) refines their boundaries with
 /// [`refine_cosegmentation`](super::refine_cosegmentation), heat-smoothing on each shape's `meshes[i]` (same order as
@@ -293,6 +388,27 @@ pub fn segment_collection(
         )));
     }
     let refine = options.refine.as_ref().filter(|r| r.max_rounds > 0);
+    let thickness = match (&options.parts, options.parts_from) {
+        (None, PartsFrom::Thickness { .. }) => {
+            return Err(GraphError::BadOption(
+                "parts from thickness need a number of parts (--parts N)".into(),
+            ));
+        }
+        (Some(p), PartsFrom::Thickness { leaves }) => {
+            let Some(parts) = p.parts else {
+                return Err(GraphError::BadOption(
+                    "parts from thickness need a number of parts (--parts N, not auto)".into(),
+                ));
+            };
+            if leaves < parts {
+                return Err(GraphError::BadOption(format!(
+                    "parts from thickness: {leaves} regions cannot make {parts} parts"
+                )));
+            }
+            Some((leaves, parts))
+        }
+        _ => None,
+    };
     let t = Instant::now();
     let smoothers = match refine {
         Some(r) if smoothing => Some(
@@ -314,7 +430,34 @@ pub fn segment_collection(
     let mut start_scores = Vec::with_capacity(options.starts);
     for start in 0..options.starts {
         let t = Instant::now();
+        let mut leaf_refine = Duration::ZERO;
         let (mut segmentation, adaptive) = match &options.parts {
+            Some(_) if thickness.is_some() => {
+                let (leaves, parts) = thickness.expect("checked");
+                let mut o = options.cosegment;
+                o.regions = leaves;
+                let mut regions = cosegment(&graph, &o)?;
+                if let Some(refine) = refine {
+                    let t = Instant::now();
+                    regions = refine_cosegmentation_sized(
+                        &graph,
+                        &regions,
+                        smoothers.as_deref(),
+                        refine,
+                        RefineSizes::Free,
+                    )?;
+                    leaf_refine = t.elapsed();
+                }
+                let links = mirror_links(&graph, meshes, &regions, options);
+                let tree = thickness_tree(meshes, &regions, &links)?;
+                let a = AdaptiveCosegmentation {
+                    leaves: regions,
+                    auto: Vec::new(),
+                    stop: StopReason::EqualAreaLeaves,
+                    tree,
+                };
+                (a.cut(parts), Some(a))
+            }
             None => {
                 let mut o = options.cosegment;
                 if start > 0 {
@@ -325,18 +468,7 @@ pub fn segment_collection(
             Some(p) => {
                 let mut a = adaptive_cosegment(&graph, p)?;
                 if options.group_mirrors {
-                    let pairs: Vec<(usize, usize)> = mirror_pairs(
-                        meshes,
-                        &a.leaves,
-                        options.up,
-                        Some(Likeness {
-                            graph: &graph,
-                            columns: &options.mirror_columns,
-                        }),
-                    )
-                    .iter()
-                    .map(|m| (m.a, m.b))
-                    .collect();
+                    let pairs = mirror_links(&graph, meshes, &a.leaves, options);
                     if !pairs.is_empty() {
                         a.regroup(&graph, &pairs);
                     }
@@ -344,8 +476,9 @@ pub fn segment_collection(
                 (a.cut(p.parts.unwrap_or(usize::MAX)), Some(a))
             }
         };
-        times.cosegment += t.elapsed();
-        if let Some(refine) = refine {
+        times.cosegment += t.elapsed() - leaf_refine;
+        times.refine += leaf_refine;
+        if let Some(refine) = refine.filter(|_| thickness.is_none()) {
             let t = Instant::now();
             segmentation = refine_cosegmentation_sized(
                 &graph,

@@ -1,0 +1,199 @@
+//! Tests of the thickness part tree (`graph::thickness_tree`) and of `--parts N --parts-from
+//! thickness` (`SegmentCollectionOptions::parts_from`).
+
+use coseg::bands::equal_count_bands;
+use coseg::graph::{
+    Cosegmentation, GraphError, PartsFrom, RegionTuple, SegmentCollectionOptions, ShapeNode,
+    StopReason, segment_collection, thickness_tree,
+};
+use coseg::mesh::TriMesh;
+
+/// A column of octagonal rings along y, ring `k` at height `0.5 k` with radius `radius(k)`,
+/// capped at both ends (the caps' centres are the last two vertices), plus, when `rod` is
+/// given, a separate thin rod (8 rings of radius 0.2) at x = `rod`. Returns the mesh and the
+/// vertices of each ring (the caps' centres with the end rings; the rod's rings after the
+/// column's).
+fn column(
+    rings: usize,
+    radius: impl Fn(usize) -> f64,
+    rod: Option<f64>,
+) -> (TriMesh, Vec<Vec<u32>>) {
+    let mut p = Vec::new();
+    let mut f = Vec::new();
+    let mut ring_vertices = Vec::new();
+    let mut tube = |p: &mut Vec<[f64; 3]>, x0: f64, rings: usize, r: &dyn Fn(usize) -> f64| {
+        let o = p.len() as u32;
+        for k in 0..rings {
+            for j in 0..8 {
+                let a = j as f64 * std::f64::consts::FRAC_PI_4;
+                p.push([x0 + r(k) * a.cos(), k as f64 * 0.5, r(k) * a.sin()]);
+            }
+            ring_vertices.push((o + 8 * k as u32..o + 8 * (k as u32 + 1)).collect::<Vec<u32>>());
+        }
+        let (bottom, top) = (p.len() as u32, p.len() as u32 + 1);
+        p.push([x0, 0.0, 0.0]);
+        p.push([x0, 0.5 * (rings - 1) as f64, 0.0]);
+        for k in 0..rings as u32 - 1 {
+            for j in 0..8u32 {
+                let (a, b) = (o + 8 * k + j, o + 8 * k + (j + 1) % 8);
+                f.push([a, a + 8, b]);
+                f.push([b, a + 8, b + 8]);
+            }
+        }
+        let last = o + 8 * (rings as u32 - 1);
+        for j in 0..8u32 {
+            f.push([bottom, o + j, o + (j + 1) % 8]);
+            f.push([top, last + (j + 1) % 8, last + j]);
+        }
+        let n = ring_vertices.len();
+        ring_vertices[n - rings].push(bottom);
+        ring_vertices[n - 1].push(top);
+    };
+    tube(&mut p, 0.0, rings, &radius);
+    if let Some(x) = rod {
+        tube(&mut p, x, 8, &|_| 0.2);
+    }
+    (TriMesh::new(p, f).unwrap(), ring_vertices)
+}
+
+/// A co-segmentation of one shape per mesh whose tuple `t` is the union of `groups[t]`'s rings.
+fn by_rings(meshes: &[TriMesh], rings: &[Vec<Vec<u32>>], groups: &[Vec<usize>]) -> Cosegmentation {
+    let n = meshes.len();
+    let tuples = groups
+        .iter()
+        .map(|g| RegionTuple {
+            area_fractions: vec![0.0; n],
+            regions: (0..n)
+                .map(|i| {
+                    let mut r: Vec<u32> = g.iter().flat_map(|&k| rings[i][k].clone()).collect();
+                    r.sort_unstable();
+                    r
+                })
+                .collect(),
+            sweeps: 0,
+            converged: true,
+            cycled: false,
+            objective: 0.0,
+            confidence: 1.0,
+            cycle_consistency: None,
+            leftover: false,
+        })
+        .collect();
+    Cosegmentation {
+        names: (0..n).map(|i| format!("s{i}")).collect(),
+        vertices: meshes.iter().map(TriMesh::vertex_count).collect(),
+        root: 0,
+        order: (0..n).collect(),
+        parent: (0..n).map(|i| (i > 0).then_some(0)).collect(),
+        alpha: 0.0,
+        tuples,
+    }
+}
+
+/// Three stepped columns of 24 rings, thick below ring 8 (radius 0.55–0.7) and thin above
+/// (0.28–0.32), so the two halves have about one area.
+fn stepped() -> (Vec<TriMesh>, Vec<Vec<Vec<u32>>>) {
+    [(0.6, 0.3), (0.7, 0.32), (0.55, 0.28)]
+        .iter()
+        .map(|&(thick, thin)| column(24, move |k| if k < 8 { thick } else { thin }, None))
+        .unzip()
+}
+
+#[test]
+fn thickness_tree_groups_touching_regions_of_one_thickness() {
+    let (meshes, rings) = stepped();
+    let groups: Vec<Vec<usize>> = (0..6).map(|t| (4 * t..4 * t + 4).collect()).collect();
+    let coseg = by_rings(&meshes, &rings, &groups);
+    let tree = thickness_tree(&meshes, &coseg, &[]).unwrap();
+    assert_eq!(tree.leaves, 6);
+    assert_eq!(tree.merges.len(), 5);
+    assert_eq!(tree.cut(2), vec![vec![0, 1], vec![2, 3, 4, 5]]);
+    // Each merge joins touching groups (a column's regions touch only their neighbours), and
+    // the last one, across the step, is the least alike.
+    for m in &tree.merges {
+        assert!(m.similarity > 0.0 && m.similarity <= 1.0, "{m:?}");
+    }
+    let last = tree.merges.last().unwrap().similarity;
+    assert!(tree.merges[..4].iter().all(|m| m.similarity > last));
+    // Deterministic, also in a pool of one thread.
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    let one = pool.install(|| thickness_tree(&meshes, &coseg, &[]).unwrap());
+    assert_eq!(one, tree);
+}
+
+#[test]
+fn thickness_tree_merges_regions_that_do_not_touch_only_when_linked() {
+    // A thick column (rings 0–7) with a thin top (rings 8–15), and a separate thin rod (rings
+    // 16–23) of the thin top's thickness.
+    let (meshes, rings): (Vec<TriMesh>, Vec<_>) = [0.0, 0.1, -0.1]
+        .iter()
+        .map(|&e| column(16, move |k| if k < 8 { 1.0 + e } else { 0.2 }, Some(4.0)))
+        .unzip();
+    let groups = vec![(0..8).collect(), (8..16).collect(), (16..24).collect()];
+    let coseg = by_rings(&meshes, &rings, &groups);
+    // Unlinked, the rod touches nothing: the column merges first whatever the thicknesses.
+    let tree = thickness_tree(&meshes, &coseg, &[]).unwrap();
+    assert_eq!(tree.cut(2), vec![vec![0, 1], vec![2]]);
+    // Linked (a mirror pair), the rod joins the thin top it resembles.
+    let tree = thickness_tree(&meshes, &coseg, &[(2, 1)]).unwrap();
+    assert_eq!(tree.cut(2), vec![vec![0], vec![1, 2]]);
+    // Meshes that do not match are refused.
+    assert!(matches!(
+        thickness_tree(&meshes[..2], &coseg, &[]),
+        Err(GraphError::BadOption(_))
+    ));
+}
+
+/// End to end through `segment_collection`: `--parts 2 --parts-from thickness --regions 6`
+/// cuts the thickness tree of six refined equal-area regions, and refuses what it cannot do.
+#[test]
+fn parts_from_thickness_cuts_the_tree_of_equal_area_regions() {
+    let (meshes, _) = stepped();
+    let nodes: Vec<ShapeNode> = meshes
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let y: Vec<f64> = m.positions().iter().map(|p| p[1]).collect();
+            let t = equal_count_bands(&y, 1, y.len(), 16).unwrap();
+            ShapeNode::new(format!("s{i}"), t, &m.vertex_areas()).unwrap()
+        })
+        .collect();
+    let mut o = SegmentCollectionOptions::default();
+    o.request_parts(coseg::graph::PartsRequest::Count(2), None);
+    o.set_parts_from(PartsFrom::Thickness { leaves: 12 }, Some(6));
+    let out = segment_collection(nodes.clone(), &meshes, &o).unwrap();
+    let a = out.adaptive.as_ref().unwrap();
+    assert_eq!(a.stop, StopReason::EqualAreaLeaves);
+    assert_eq!(a.leaves.tuples.len(), 6);
+    assert_eq!(out.segmentation.tuples.len(), 2);
+    // The parts are the tree's cut of the refined equal-area leaves, with no refinement after.
+    assert_eq!(out.segmentation, a.cut(2));
+    let links: Vec<(usize, usize)> = coseg::graph::mirror_pairs(&meshes, &a.leaves, None, None)
+        .iter()
+        .map(|m| (m.a, m.b))
+        .collect();
+    assert_eq!(a.tree, thickness_tree(&meshes, &a.leaves, &links).unwrap());
+    // Deterministic.
+    let again = segment_collection(nodes.clone(), &meshes, &o).unwrap();
+    assert_eq!(again.segmentation, out.segmentation);
+    // A number of parts is needed, and enough regions to make them.
+    o.request_parts(coseg::graph::PartsRequest::Auto, None);
+    assert!(matches!(
+        segment_collection(nodes.clone(), &meshes, &o),
+        Err(GraphError::BadOption(_))
+    ));
+    o.request_parts(coseg::graph::PartsRequest::Count(8), None);
+    assert!(matches!(
+        segment_collection(nodes.clone(), &meshes, &o),
+        Err(GraphError::BadOption(_))
+    ));
+    let mut none = SegmentCollectionOptions::default();
+    none.parts_from = PartsFrom::Thickness { leaves: 6 };
+    assert!(matches!(
+        segment_collection(nodes, &meshes, &none),
+        Err(GraphError::BadOption(_))
+    ));
+}
