@@ -3,13 +3,13 @@
 //! ```text
 //! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N]
 //!     [--features F --up AXIS [--normals N]] [--starts N] [--keep-sizes TOL] [--detail]
-//!     [--parts-from adaptive|thickness] MODE...
+//!     [--parts-from adaptive|geometry] MODE...
 //! ```
 //! `--features`/`--up`/`--normals` select the feature families as `coseg segment` does (e.g.
 //! `--features spectral,extrinsic --up y --normals 16`), `--starts` its several starts, `--keep-sizes TOL`
 //! the size-aware refinement (`RefineSizes::Keep`, `coseg segment --refine-sizes keep:TOL`;
 //! without it the free best response), `--parts-from` where `parts:N` takes its finest parts
-//! (`coseg segment --parts-from`; with `thickness`, `@max=R` is the number of regions).
+//! (`coseg segment --parts-from`; with `geometry`, `@max=R` is the number of regions).
 //! `--detail` prints, for families, each shape's own purity / coverage, the pooled area table
 //! (region × grouped part, % of a shape) and the best any grouping of the regions could score.
 //! `FOLDER` is either a COSEG-style set (`shapes/N.off` and `gt/N.seg`, one label per face) or a
@@ -361,6 +361,19 @@ fn main() -> Res<()> {
                 "  final mirror pairs: {}",
                 mirror_check(&loaded, seg, &folder, o.up, likeness)?
             );
+        }
+        if let (true, false, Some(a)) = (detail, coseg_set, out.adaptive.as_ref()) {
+            eprintln!("  leaves:");
+            family_scores(&loaded, &a.leaves, &folder, true)?;
+            eprintln!(
+                "  tree: {:?}",
+                a.tree
+                    .merges
+                    .iter()
+                    .map(|m| (m.a, m.b, (100.0 * m.similarity).round() / 100.0))
+                    .collect::<Vec<_>>()
+            );
+            eprintln!("  final:");
         }
         let score = if coseg_set {
             format!(

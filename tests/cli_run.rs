@@ -229,11 +229,11 @@ fn refine_sizes_is_recorded_and_checked() {
     }
 }
 
-/// `--parts N --parts-from thickness`: N parts cut from `--regions` equal-area regions,
+/// `--parts N --parts-from geometry`: N parts cut from `--regions` equal-area regions,
 /// recorded in summary.json (the option, the stop reason, the leaves); `--parts auto` and no
 /// `--parts` are refused with a message, as is an unknown kind.
 #[test]
-fn parts_from_thickness_is_recorded_and_checked() {
+fn parts_from_geometry_is_recorded_and_checked() {
     let dir = tempfile::tempdir().unwrap();
     let input = dir.path().join("in");
     std::fs::create_dir(&input).unwrap();
@@ -248,21 +248,14 @@ fn parts_from_thickness_is_recorded_and_checked() {
     };
     let (run, out) = run_with(
         "t",
-        &[
-            "--parts",
-            "2",
-            "--parts-from",
-            "thickness",
-            "--regions",
-            "5",
-        ],
+        &["--parts", "2", "--parts-from", "geometry", "--regions", "5"],
     );
     assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
     let summary: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(
         summary["options"]["parts_from"],
-        serde_json::json!({"kind": "thickness", "leaves": 5})
+        serde_json::json!({"kind": "geometry", "leaves": 5})
     );
     assert_eq!(summary["parts"]["stop"]["reason"], "equal_area_leaves");
     assert_eq!(summary["parts"]["leaf_areas"].as_array().unwrap().len(), 5);
@@ -272,11 +265,8 @@ fn parts_from_thickness_is_recorded_and_checked() {
     );
     assert_eq!(summary["regions"].as_array().unwrap().len(), 2);
     for (name, extra) in [
-        (
-            "auto",
-            &["--parts", "auto", "--parts-from", "thickness"][..],
-        ),
-        ("noparts", &["--parts-from", "thickness"][..]),
+        ("auto", &["--parts", "auto", "--parts-from", "geometry"][..]),
+        ("noparts", &["--parts-from", "geometry"][..]),
     ] {
         let (run, _) = run_with(name, extra);
         assert_ne!(run.status.code(), Some(0), "{name}");

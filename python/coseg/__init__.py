@@ -464,8 +464,8 @@ def segment(
     mean confidence (equal-area mode only: with ``parts`` it raises :class:`InputError`); ``refine_sizes`` (``"free"``): ``"keep"`` or
     ``"keep:TOL"`` keeps each part's area within a factor 1 + TOL (default 0.5) of its
     area before refinement (meant for ``parts``); ``parts_from`` (``"adaptive"``): with
-    ``parts=N``, ``"thickness"`` takes ``regions`` (default 12) equal-area regions and groups
-    touching ones (and left/right copies) of one thickness (``--parts-from thickness``,
+    ``parts=N``, ``"geometry"`` takes ``regions`` (default 12) equal-area regions and groups
+    touching ones (and left/right copies) of one thickness across convex boundaries (``--parts-from geometry``,
     docs/PARTS.md); ``area_fraction`` (None: 1 / regions) of
     each region; ``seed`` (None: start from the most distinctive vertex); ``complete_limit``
     (12): collections up to this size use a complete shape graph, larger ones ``neighbours``

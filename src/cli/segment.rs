@@ -31,7 +31,7 @@ pub struct SegmentArgs {
     #[arg(long)]
     cache: Option<PathBuf>,
     /// Regions per shape, the last being the leftovers (default 6); with `--parts`, the upper
-    /// bound on the number of parts (default 8); with `--parts-from thickness`, the number of
+    /// bound on the number of parts (default 8); with `--parts-from geometry`, the number of
     /// equal-area regions grouped into parts (default 12).
     #[arg(long)]
     regions: Option<usize>,
@@ -42,9 +42,9 @@ pub struct SegmentArgs {
     #[arg(long, value_parser = parse_parts)]
     parts: Option<PartsRequest>,
     /// With `--parts N`, where the finest parts come from: `adaptive` (default; tuples of their
-    /// own size, grouped by what the affinity transports) or `thickness` (`--regions`
-    /// equal-area regions, default 12, and touching ones or left/right copies of one
-    /// thickness grouped first; best measured on the generated families, docs/PARTS.md).
+    /// own size, grouped by what the affinity transports) or `geometry` (`--regions`
+    /// equal-area regions, default 12, grouped first where they touch or are left/right copies,
+    /// have one thickness and meet over convex surface; docs/PARTS.md).
     #[arg(long, value_parser = parse_parts_from)]
     parts_from: Option<PartsFrom>,
     /// Area of each region as a fraction of its shape (default: 1 / regions).
@@ -89,7 +89,7 @@ fn parse_refine_sizes(s: &str) -> Result<RefineSizes, String> {
     s.parse().map_err(|e: GraphError| e.to_string())
 }
 
-/// `--parts-from adaptive|thickness`.
+/// `--parts-from adaptive|geometry`.
 fn parse_parts_from(s: &str) -> Result<PartsFrom, String> {
     s.parse().map_err(|e: GraphError| e.to_string())
 }

@@ -167,8 +167,8 @@ pub enum StopReason {
         /// The rejected tuple's median area fraction.
         area: f64,
     },
-    /// Nothing was extracted: the leaves are equal-area regions grouped by thickness
-    /// ([`super::PartsFrom::Thickness`]).
+    /// Nothing was extracted: the leaves are equal-area regions grouped by geometry
+    /// ([`super::PartsFrom::Geometry`]).
     EqualAreaLeaves,
 }
 
@@ -196,7 +196,7 @@ impl std::fmt::Display for StopReason {
             ),
             Self::EqualAreaLeaves => write!(
                 f,
-                "the finest parts are equal-area regions, grouped by thickness"
+                "the finest parts are equal-area regions, grouped by thickness and concavity"
             ),
             Self::TooSmall { area } => write!(
                 f,

@@ -13,8 +13,8 @@
 //!   (Algorithm 3 across the graph), the number of parts from the data and a tree of parts.
 //! - [`mirror_pairs`]: which tuples are left/right copies of each other (each shape's own
 //!   plane of mirror symmetry, [`mirror_plane`]); the part tree merges them first.
-//! - [`thickness_tree`]: a part tree over equal-area regions that merges touching regions
-//!   (and mirror pairs) of one thickness (`--parts N --parts-from thickness`).
+//! - [`geometric_part_tree`]: a part tree over equal-area regions that merges touching regions
+//!   (and mirror pairs) of one thickness (`--parts N --parts-from geometry`).
 //! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
 //!   boundaries over every edge of the graph.
 //! - [`segment_collection`]: graph, co-segmentation and refinement in one call, as
@@ -24,13 +24,13 @@
 mod adaptive_cosegment;
 mod cosegment;
 mod cycle_consistency;
+mod geometric_part_tree;
 mod load_collection;
 mod mirror_pairs;
 mod refine_cosegmentation;
 mod segment_collection;
 mod shape_graph;
 mod stable_cycle;
-mod thickness_tree;
 
 pub use adaptive_cosegment::{
     AdaptiveCosegmentation, AdaptiveOptions, AutoTuple, PartMerge, PartTree, PartsReport, Sizing,
@@ -38,6 +38,7 @@ pub use adaptive_cosegment::{
 };
 pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
 pub use cycle_consistency::{CycleConsistency, cycle_consistency};
+pub use geometric_part_tree::geometric_part_tree;
 pub use load_collection::{
     LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
 };
@@ -56,7 +57,6 @@ pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode,
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
 };
-pub use thickness_tree::thickness_tree;
 
 use crate::affinity::AffinityError;
 use thiserror::Error;
@@ -87,7 +87,7 @@ pub enum GraphError {
         #[source]
         source: crate::spectral::SpectralError,
     },
-    /// A shape's thickness (shape diameter function) for [`thickness_tree`] could not be
+    /// A shape's thickness (shape diameter function) for [`geometric_part_tree`] could not be
     /// computed.
     #[error("shape {name}: thickness (SDF): {source}")]
     Thickness {

@@ -4,8 +4,8 @@
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    Likeness, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment, mirror_pairs,
-    refine_cosegmentation_sized, thickness_tree,
+    Likeness, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment,
+    geometric_part_tree, mirror_pairs, refine_cosegmentation_sized,
 };
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -75,7 +75,7 @@ pub struct SegmentCollectionOptions {
 }
 
 /// Where `--parts N` takes its finest parts from, and how it groups them
-/// (`coseg segment --parts-from adaptive|thickness`; measured side by side in docs/PARTS.md).
+/// (`coseg segment --parts-from adaptive|geometry`; measured side by side in docs/PARTS.md).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
 #[serde(rename_all = "snake_case", tag = "kind")]
 pub enum PartsFrom {
@@ -84,21 +84,21 @@ pub enum PartsFrom {
     #[default]
     Adaptive,
     /// `leaves` equal-area regions ([`cosegment`], refined), grouped by
-    /// [`super::thickness_tree`]: touching regions (and mirror pairs) of one thickness merge
-    /// first. Needs the meshes and a number of parts; no refinement after the cut (it would
+    /// [`super::geometric_part_tree`]: touching regions (and mirror pairs) of one thickness
+    /// across convex boundaries merge first. Needs the meshes and a number of parts; no refinement after the cut (it would
     /// drift the grouped parts back towards equal areas).
-    Thickness {
+    Geometry {
         /// Number of equal-area regions (the finest parts; `coseg segment --regions`,
-        /// default [`PartsFrom::THICKNESS_LEAVES`]).
+        /// default [`PartsFrom::GEOMETRY_LEAVES`]).
         leaves: usize,
     },
 }
 
 impl PartsFrom {
-    /// The default number of leaves of [`PartsFrom::Thickness`]: enough that each region lies
+    /// The default number of leaves of [`PartsFrom::Geometry`]: enough that each region lies
     /// mostly in one part of a body or a chair (measured: 84–92 % of their area on the
     /// generated families), few enough that each is a sizeable piece of a part.
-    pub const THICKNESS_LEAVES: usize = 12;
+    pub const GEOMETRY_LEAVES: usize = 12;
 
     fn is_adaptive(&self) -> bool {
         *self == Self::Adaptive
@@ -108,21 +108,21 @@ impl PartsFrom {
 impl std::str::FromStr for PartsFrom {
     type Err = GraphError;
 
-    /// `adaptive` or `thickness` (with [`PartsFrom::THICKNESS_LEAVES`] leaves).
+    /// `adaptive` or `geometry` (with [`PartsFrom::GEOMETRY_LEAVES`] leaves).
     ///
     /// ```
     /// use coseg::graph::PartsFrom;
-    /// assert_eq!("thickness".parse::<PartsFrom>().unwrap(), PartsFrom::Thickness { leaves: 12 });
+    /// assert_eq!("geometry".parse::<PartsFrom>().unwrap(), PartsFrom::Geometry { leaves: 12 });
     /// assert!("size".parse::<PartsFrom>().is_err());
     /// ```
     fn from_str(s: &str) -> Result<Self, GraphError> {
         match s {
             "adaptive" => Ok(Self::Adaptive),
-            "thickness" => Ok(Self::Thickness {
-                leaves: Self::THICKNESS_LEAVES,
+            "geometry" => Ok(Self::Geometry {
+                leaves: Self::GEOMETRY_LEAVES,
             }),
             _ => Err(GraphError::BadOption(format!(
-                "{s:?}: expected `adaptive` or `thickness`"
+                "{s:?}: expected `adaptive` or `geometry`"
             ))),
         }
     }
@@ -211,17 +211,17 @@ impl SegmentCollectionOptions {
 
 impl SegmentCollectionOptions {
     /// Sets [`Self::parts_from`]; `regions` (`coseg segment --regions`), when given, is the
-    /// number of leaves of [`PartsFrom::Thickness`].
+    /// number of leaves of [`PartsFrom::Geometry`].
     ///
     /// ```
     /// use coseg::graph::{PartsFrom, SegmentCollectionOptions};
     /// let mut o = SegmentCollectionOptions::default();
-    /// o.set_parts_from(PartsFrom::Thickness { leaves: 12 }, Some(16));
-    /// assert_eq!(o.parts_from, PartsFrom::Thickness { leaves: 16 });
+    /// o.set_parts_from(PartsFrom::Geometry { leaves: 12 }, Some(16));
+    /// assert_eq!(o.parts_from, PartsFrom::Geometry { leaves: 16 });
     /// ```
     pub fn set_parts_from(&mut self, from: PartsFrom, regions: Option<usize>) {
         self.parts_from = match (from, regions) {
-            (PartsFrom::Thickness { .. }, Some(leaves)) => PartsFrom::Thickness { leaves },
+            (PartsFrom::Geometry { .. }, Some(leaves)) => PartsFrom::Geometry { leaves },
             (f, _) => f,
         };
     }
@@ -388,21 +388,21 @@ pub fn segment_collection(
         )));
     }
     let refine = options.refine.as_ref().filter(|r| r.max_rounds > 0);
-    let thickness = match (&options.parts, options.parts_from) {
-        (None, PartsFrom::Thickness { .. }) => {
+    let geometry = match (&options.parts, options.parts_from) {
+        (None, PartsFrom::Geometry { .. }) => {
             return Err(GraphError::BadOption(
-                "parts from thickness need a number of parts (--parts N)".into(),
+                "parts from geometry need a number of parts (--parts N)".into(),
             ));
         }
-        (Some(p), PartsFrom::Thickness { leaves }) => {
+        (Some(p), PartsFrom::Geometry { leaves }) => {
             let Some(parts) = p.parts else {
                 return Err(GraphError::BadOption(
-                    "parts from thickness need a number of parts (--parts N, not auto)".into(),
+                    "parts from geometry need a number of parts (--parts N, not auto)".into(),
                 ));
             };
             if leaves < parts {
                 return Err(GraphError::BadOption(format!(
-                    "parts from thickness: {leaves} regions cannot make {parts} parts"
+                    "parts from geometry: {leaves} regions cannot make {parts} parts"
                 )));
             }
             Some((leaves, parts))
@@ -432,8 +432,8 @@ pub fn segment_collection(
         let t = Instant::now();
         let mut leaf_refine = Duration::ZERO;
         let (mut segmentation, adaptive) = match &options.parts {
-            Some(_) if thickness.is_some() => {
-                let (leaves, parts) = thickness.expect("checked");
+            Some(_) if geometry.is_some() => {
+                let (leaves, parts) = geometry.expect("checked");
                 let mut o = options.cosegment;
                 o.regions = leaves;
                 let mut regions = cosegment(&graph, &o)?;
@@ -449,7 +449,7 @@ pub fn segment_collection(
                     leaf_refine = t.elapsed();
                 }
                 let links = mirror_links(&graph, meshes, &regions, options);
-                let tree = thickness_tree(meshes, &regions, &links)?;
+                let tree = geometric_part_tree(meshes, &regions, &links)?;
                 let a = AdaptiveCosegmentation {
                     leaves: regions,
                     auto: Vec::new(),
@@ -478,7 +478,7 @@ pub fn segment_collection(
         };
         times.cosegment += t.elapsed() - leaf_refine;
         times.refine += leaf_refine;
-        if let Some(refine) = refine.filter(|_| thickness.is_none()) {
+        if let Some(refine) = refine.filter(|_| geometry.is_none()) {
             let t = Instant::now();
             segmentation = refine_cosegmentation_sized(
                 &graph,

@@ -1,29 +1,35 @@
-//! [`thickness_tree`]: a part tree over co-segmented regions that merges touching regions of
-//! one thickness (and mirror pairs), for `coseg segment --parts N --parts-from thickness`.
+//! [`geometric_part_tree`]: a part tree over co-segmented regions that merges touching
+//! regions of one thickness across convex boundaries (and mirror pairs), for `coseg segment
+//! --parts N --parts-from geometry`.
 //!
 //! Why: cut into a dozen equal-area regions, the generated families' regions are nearly pure
 //! (one true part each: 84–92 % of their area, docs/PARTS.md), so how well `--parts N` does
 //! rests on which regions it groups. Grouping by what the affinity transports (the adaptive
 //! tree) or by intrinsic look-alike merges a leg with an arm and the hips with the legs: the
 //! spectral features of a limb's end differ from its root's more than from another limb's.
-//! Semantic parts are made of touching pieces of about one thickness: the thickness changes
-//! where a limb meets the torso, not along the limb. So the tree merges, among regions that
-//! touch on most shapes (or are mirror pairs: the two arms), the two whose thickness differs
-//! least, with complete linkage: a group's thickness spread stays small.
+//! Two geometric cues of a part boundary do not depend on where along a part a cut falls:
+//! the **thickness** jumps where a limb meets the torso, a stem meets a bowl; and the surface
+//! is **concave** along such a junction (the minima rule of Hoffman and Richards), while a cut
+//! across a limb or a torso runs over convex surface. So the tree merges, among regions that
+//! touch on most shapes (or are mirror pairs: the two arms), the two of least cost
 //!
-//! Thickness of a region on a shape: the area-weighted geometric mean of the raw shape
-//! diameter function ([`crate::features::shape_diameter`], one smoothing round) over its
-//! vertices; the SDF is scale-normalised per shape, so thicknesses compare across shapes.
-//! Distance of two regions: the median over shapes of `|ln t_a − ln t_b|`; of two groups, the
-//! largest distance between their members (complete linkage). Each merge records the
-//! similarity `exp(−distance)`: the thickness ratio (thinner over thicker, 1 = alike).
+//! `cost(a, b) = max_{x ∈ a, y ∈ b} d(x, y) + mean_{x ∈ a, y ∈ b touching} c(x, y)`,
+//!
+//! both terms dimensionless: `d(x, y)` = the (upper) median over shapes of `|ln t_x − ln t_y|`,
+//! `t` a region's thickness on a shape (the area-weighted geometric mean of the raw shape
+//! diameter function, [`crate::features::shape_diameter`] with one smoothing round,
+//! scale-normalised per shape); `c(x, y)` = the (upper) median over shapes of the concave
+//! share of their common boundary (the length of boundary edges whose endpoints' mean
+//! curvature sums to < 0, [`crate::features::mean_curvature`], over the boundary's length;
+//! 0 for linked regions that do not touch). Complete linkage on thickness keeps a group's
+//! thickness spread small. Each merge records the similarity `exp(−cost)` (1 = alike).
 
 use super::{Cosegmentation, GraphError, PartMerge, PartTree};
 use crate::features::{SdfOptions, shape_diameter};
 use crate::mesh::TriMesh;
 use rayon::prelude::*;
 
-/// The part tree of `coseg`'s tuples by thickness (module docs).
+/// The part tree of `coseg`'s tuples by thickness and boundary concavity (module docs).
 ///
 /// Inputs: `meshes` (#shapes, graph order, #V_i vertices each, as `coseg`'s regions index
 /// them); `coseg` (its tuples are the leaves); `links`, pairs of leaves that may merge without
@@ -45,11 +51,15 @@ use rayon::prelude::*;
 /// See also: [`super::AdaptiveCosegmentation::regroup`] (the transport-similarity tree),
 /// [`super::SegmentCollectionOptions::parts_from`].
 ///
+/// Cost (besides the SDF): one mean-curvature estimate per shape and a pass over its faces.
+///
 /// Known issue: a region that straddles a part boundary (a shoulder: half torso, half arm) has
-/// an in-between thickness and may join either side, or a third part (the head).
+/// an in-between thickness and may join either side, or a third part (the head); a region
+/// that is a hand on some shapes and a thigh on others (arms hanging down) joins the arms to
+/// the legs.
 ///
 /// ```
-/// use coseg::graph::{thickness_tree, Cosegmentation, RegionTuple};
+/// use coseg::graph::{geometric_part_tree, Cosegmentation, RegionTuple};
 /// use coseg::mesh::TriMesh;
 /// // A column of octagonal rings along y: a thick lower half and a thin upper half; the
 /// // regions are rings 0–3, 4–7, 8–11 and 12–15 (the caps' centres in the end regions).
@@ -87,11 +97,11 @@ use rayon::prelude::*;
 ///     cycle_consistency: None, leftover: false };
 /// let coseg = Cosegmentation { names: vec!["s".into()], vertices: vec![130], root: 0,
 ///     order: vec![0], parent: vec![None], alpha: 0.25, tuples: (0..4).map(tuple).collect() };
-/// let tree = thickness_tree(&[mesh], &coseg, &[]).unwrap();
+/// let tree = geometric_part_tree(&[mesh], &coseg, &[]).unwrap();
 /// assert_eq!(tree.merges.len(), 3);
 /// assert_eq!(tree.cut(2), vec![vec![0, 1], vec![2, 3]]);
 /// ```
-pub fn thickness_tree(
+pub fn geometric_part_tree(
     meshes: &[TriMesh],
     coseg: &Cosegmentation,
     links: &[(usize, usize)],
@@ -149,7 +159,7 @@ pub fn thickness_tree(
                 .collect()
         })
         .collect();
-    let mut linked = touching(meshes, coseg);
+    let (mut linked, concave) = boundaries(meshes, coseg);
     for &(a, b) in links {
         if a < l && b < l {
             linked[a][b] = true;
@@ -159,14 +169,22 @@ pub fn thickness_tree(
     let mut members: Vec<Vec<usize>> = (0..l).map(|x| vec![x]).collect();
     let mut alive = vec![true; l];
     let mut merges = Vec::with_capacity(l.saturating_sub(1));
-    let group_distance = |ma: &[usize], mb: &[usize]| -> f64 {
-        ma.iter()
-            .flat_map(|&x| mb.iter().map(move |&y| (x, y)))
-            .map(|(x, y)| distance[x][y])
-            .fold(0.0, f64::max)
+    let cost = |ma: &[usize], mb: &[usize]| -> f64 {
+        let pairs = || ma.iter().flat_map(|&x| mb.iter().map(move |&y| (x, y)));
+        let thickness = pairs().map(|(x, y)| distance[x][y]).fold(0.0, f64::max);
+        let shares: Vec<f64> = pairs()
+            .map(|(x, y)| concave[x][y])
+            .filter(|c| c.is_finite())
+            .collect();
+        let share = if shares.is_empty() {
+            0.0
+        } else {
+            shares.iter().sum::<f64>() / shares.len() as f64
+        };
+        thickness + share
     };
     while merges.len() + 1 < l {
-        // (unlinked, distance, a, b): linked pairs first, then the closest.
+        // (unlinked, cost, a, b): linked pairs first, then the cheapest.
         let mut best: Option<(bool, f64, usize, usize)> = None;
         for a in 0..members.len() {
             for b in a + 1..members.len() {
@@ -176,7 +194,7 @@ pub fn thickness_tree(
                 let touch = members[a]
                     .iter()
                     .any(|&x| members[b].iter().any(|&y| linked[x][y]));
-                let key = (!touch, group_distance(&members[a], &members[b]), a, b);
+                let key = (!touch, cost(&members[a], &members[b]), a, b);
                 if best.is_none_or(|bk| (key.0, key.1) < (bk.0, bk.1)) {
                     best = Some(key);
                 }
@@ -208,30 +226,62 @@ fn upper_median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
-/// `touch[a][b]`: tuples `a` and `b` share a mesh edge on at least half of the shapes.
-fn touching(meshes: &[TriMesh], coseg: &Cosegmentation) -> Vec<Vec<bool>> {
+/// For each pair of tuples: whether they share a mesh edge on at least half of the shapes,
+/// and then the (upper) median over those shapes of the concave share of their boundary
+/// (module docs; NaN where they do not touch).
+fn boundaries(meshes: &[TriMesh], coseg: &Cosegmentation) -> (Vec<Vec<bool>>, Vec<Vec<f64>>) {
     let l = coseg.tuples.len();
-    let mut count = vec![vec![0usize; l]; l];
+    let mut shares: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); l]; l];
     for (i, mesh) in meshes.iter().enumerate() {
+        let h = crate::features::mean_curvature(mesh);
         let labels = coseg.labels(i);
-        let mut seen = vec![vec![false; l]; l];
+        let p = mesh.positions();
+        // (concave length, length) of each pair's boundary edges; an interior edge is seen
+        // from both of its faces, so both sums count it twice.
+        let mut len = vec![vec![(0.0, 0.0); l]; l];
         for f in mesh.faces() {
             for k in 0..3 {
-                let (x, y) = (labels[f[k] as usize], labels[f[(k + 1) % 3] as usize]);
-                if x >= 0 && y >= 0 && x != y {
-                    seen[x as usize][y as usize] = true;
-                    seen[y as usize][x as usize] = true;
+                let (u, v) = (f[k] as usize, f[(k + 1) % 3] as usize);
+                let (x, y) = (labels[u], labels[v]);
+                if x < 0 || y < 0 || x == y {
+                    continue;
+                }
+                let e = (0..3)
+                    .map(|c| (p[u][c] - p[v][c]).powi(2))
+                    .sum::<f64>()
+                    .sqrt();
+                let c = if h[u] + h[v] < 0.0 { e } else { 0.0 };
+                for (a, b) in [(x as usize, y as usize), (y as usize, x as usize)] {
+                    len[a][b].0 += c;
+                    len[a][b].1 += e;
                 }
             }
         }
-        for (c, s) in count.iter_mut().zip(&seen) {
-            for (c, &s) in c.iter_mut().zip(s) {
-                *c += usize::from(s);
+        for (row, out) in len.iter().zip(shares.iter_mut()) {
+            for (&(c, e), out) in row.iter().zip(out.iter_mut()) {
+                if e > 0.0 {
+                    out.push(c / e);
+                }
             }
         }
     }
-    count
+    let touch = shares
         .iter()
-        .map(|row| row.iter().map(|&c| 2 * c >= meshes.len()).collect())
-        .collect()
+        .map(|row| {
+            row.iter()
+                .map(|v| 2 * v.len() >= meshes.len() && !v.is_empty())
+                .collect()
+        })
+        .collect::<Vec<Vec<bool>>>();
+    let concave = shares
+        .into_iter()
+        .zip(&touch)
+        .map(|(row, t)| {
+            row.into_iter()
+                .zip(t)
+                .map(|(v, &t)| if t { upper_median(v) } else { f64::NAN })
+                .collect()
+        })
+        .collect();
+    (touch, concave)
 }

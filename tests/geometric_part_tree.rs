@@ -1,10 +1,10 @@
-//! Tests of the thickness part tree (`graph::thickness_tree`) and of `--parts N --parts-from
-//! thickness` (`SegmentCollectionOptions::parts_from`).
+//! Tests of the geometric part tree (`graph::geometric_part_tree`: thickness and boundary
+//! concavity) and of `--parts N --parts-from geometry` (`SegmentCollectionOptions::parts_from`).
 
 use coseg::bands::equal_count_bands;
 use coseg::graph::{
     Cosegmentation, GraphError, PartsFrom, RegionTuple, SegmentCollectionOptions, ShapeNode,
-    StopReason, segment_collection, thickness_tree,
+    StopReason, geometric_part_tree, segment_collection,
 };
 use coseg::mesh::TriMesh;
 
@@ -100,11 +100,11 @@ fn stepped() -> (Vec<TriMesh>, Vec<Vec<Vec<u32>>>) {
 }
 
 #[test]
-fn thickness_tree_groups_touching_regions_of_one_thickness() {
+fn geometric_part_tree_groups_touching_regions_of_one_thickness() {
     let (meshes, rings) = stepped();
     let groups: Vec<Vec<usize>> = (0..6).map(|t| (4 * t..4 * t + 4).collect()).collect();
     let coseg = by_rings(&meshes, &rings, &groups);
-    let tree = thickness_tree(&meshes, &coseg, &[]).unwrap();
+    let tree = geometric_part_tree(&meshes, &coseg, &[]).unwrap();
     assert_eq!(tree.leaves, 6);
     assert_eq!(tree.merges.len(), 5);
     assert_eq!(tree.cut(2), vec![vec![0, 1], vec![2, 3, 4, 5]]);
@@ -120,12 +120,12 @@ fn thickness_tree_groups_touching_regions_of_one_thickness() {
         .num_threads(1)
         .build()
         .unwrap();
-    let one = pool.install(|| thickness_tree(&meshes, &coseg, &[]).unwrap());
+    let one = pool.install(|| geometric_part_tree(&meshes, &coseg, &[]).unwrap());
     assert_eq!(one, tree);
 }
 
 #[test]
-fn thickness_tree_merges_regions_that_do_not_touch_only_when_linked() {
+fn geometric_part_tree_merges_regions_that_do_not_touch_only_when_linked() {
     // A thick column (rings 0–7) with a thin top (rings 8–15), and a separate thin rod (rings
     // 16–23) of the thin top's thickness.
     let (meshes, rings): (Vec<TriMesh>, Vec<_>) = [0.0, 0.1, -0.1]
@@ -135,22 +135,22 @@ fn thickness_tree_merges_regions_that_do_not_touch_only_when_linked() {
     let groups = vec![(0..8).collect(), (8..16).collect(), (16..24).collect()];
     let coseg = by_rings(&meshes, &rings, &groups);
     // Unlinked, the rod touches nothing: the column merges first whatever the thicknesses.
-    let tree = thickness_tree(&meshes, &coseg, &[]).unwrap();
+    let tree = geometric_part_tree(&meshes, &coseg, &[]).unwrap();
     assert_eq!(tree.cut(2), vec![vec![0, 1], vec![2]]);
     // Linked (a mirror pair), the rod joins the thin top it resembles.
-    let tree = thickness_tree(&meshes, &coseg, &[(2, 1)]).unwrap();
+    let tree = geometric_part_tree(&meshes, &coseg, &[(2, 1)]).unwrap();
     assert_eq!(tree.cut(2), vec![vec![0], vec![1, 2]]);
     // Meshes that do not match are refused.
     assert!(matches!(
-        thickness_tree(&meshes[..2], &coseg, &[]),
+        geometric_part_tree(&meshes[..2], &coseg, &[]),
         Err(GraphError::BadOption(_))
     ));
 }
 
-/// End to end through `segment_collection`: `--parts 2 --parts-from thickness --regions 6`
-/// cuts the thickness tree of six refined equal-area regions, and refuses what it cannot do.
+/// End to end through `segment_collection`: `--parts 2 --parts-from geometry --regions 6`
+/// cuts the geometric part tree of six refined equal-area regions, and refuses what it cannot do.
 #[test]
-fn parts_from_thickness_cuts_the_tree_of_equal_area_regions() {
+fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
     let (meshes, _) = stepped();
     let nodes: Vec<ShapeNode> = meshes
         .iter()
@@ -163,7 +163,7 @@ fn parts_from_thickness_cuts_the_tree_of_equal_area_regions() {
         .collect();
     let mut o = SegmentCollectionOptions::default();
     o.request_parts(coseg::graph::PartsRequest::Count(2), None);
-    o.set_parts_from(PartsFrom::Thickness { leaves: 12 }, Some(6));
+    o.set_parts_from(PartsFrom::Geometry { leaves: 12 }, Some(6));
     let out = segment_collection(nodes.clone(), &meshes, &o).unwrap();
     let a = out.adaptive.as_ref().unwrap();
     assert_eq!(a.stop, StopReason::EqualAreaLeaves);
@@ -175,7 +175,10 @@ fn parts_from_thickness_cuts_the_tree_of_equal_area_regions() {
         .iter()
         .map(|m| (m.a, m.b))
         .collect();
-    assert_eq!(a.tree, thickness_tree(&meshes, &a.leaves, &links).unwrap());
+    assert_eq!(
+        a.tree,
+        geometric_part_tree(&meshes, &a.leaves, &links).unwrap()
+    );
     // Deterministic.
     let again = segment_collection(nodes.clone(), &meshes, &o).unwrap();
     assert_eq!(again.segmentation, out.segmentation);
@@ -191,7 +194,7 @@ fn parts_from_thickness_cuts_the_tree_of_equal_area_regions() {
         Err(GraphError::BadOption(_))
     ));
     let mut none = SegmentCollectionOptions::default();
-    none.parts_from = PartsFrom::Thickness { leaves: 6 };
+    none.parts_from = PartsFrom::Geometry { leaves: 6 };
     assert!(matches!(
         segment_collection(nodes, &meshes, &none),
         Err(GraphError::BadOption(_))
