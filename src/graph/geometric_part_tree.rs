@@ -166,6 +166,21 @@ pub fn geometric_part_tree(
             linked[b][a] = true;
         }
     }
+    Ok(PartTree {
+        leaves: l,
+        merges: merge_order(&distance, &linked, &concave),
+    })
+}
+
+/// The merges of the module docs from the leaves' thickness distances `d`, which leaves may
+/// merge (`linked`: touching or mirror pairs) and their boundaries' concave shares `c` (NaN
+/// where they do not touch); all #leaves by #leaves.
+fn merge_order(
+    distance: &[Vec<f64>],
+    linked: &[Vec<bool>],
+    concave: &[Vec<f64>],
+) -> Vec<PartMerge> {
+    let l = distance.len();
     let mut members: Vec<Vec<usize>> = (0..l).map(|x| vec![x]).collect();
     let mut alive = vec![true; l];
     let mut merges = Vec::with_capacity(l.saturating_sub(1));
@@ -215,7 +230,7 @@ pub fn geometric_part_tree(
             similarity: (-d).exp(),
         });
     }
-    Ok(PartTree { leaves: l, merges })
+    merges
 }
 
 /// The upper median of `v` (non-empty): for an even length the higher middle value, so the
@@ -284,4 +299,121 @@ fn boundaries(meshes: &[TriMesh], coseg: &Cosegmentation) -> (Vec<Vec<bool>>, Ve
         })
         .collect();
     (touch, concave)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::RegionTuple;
+    use super::*;
+
+    /// A chain of four regions of one thickness, 0–1–2–3: the concave boundary (1, 2) is merged
+    /// last, so two parts are {0, 1} and {2, 3}; with a convex one there it would not be.
+    #[test]
+    fn a_concave_boundary_between_regions_of_one_thickness_is_merged_last() {
+        let d = vec![vec![0.0; 4]; 4];
+        let mut linked = vec![vec![false; 4]; 4];
+        let mut c = vec![vec![f64::NAN; 4]; 4];
+        for (a, b, share) in [(0, 1, 0.1), (1, 2, 0.9), (2, 3, 0.1)] {
+            linked[a][b] = true;
+            linked[b][a] = true;
+            c[a][b] = share;
+            c[b][a] = share;
+        }
+        let tree = PartTree {
+            leaves: 4,
+            merges: merge_order(&d, &linked, &c),
+        };
+        assert_eq!(tree.cut(2), vec![vec![0, 1], vec![2, 3]]);
+        assert_eq!(tree.merges[2].similarity, (-0.9f64).exp());
+        // Convex everywhere but (0, 1): {0, 1} is the part boundary now.
+        c[0][1] = 0.9;
+        c[1][0] = 0.9;
+        c[1][2] = 0.1;
+        c[2][1] = 0.1;
+        let tree = PartTree {
+            leaves: 4,
+            merges: merge_order(&d, &linked, &c),
+        };
+        assert_eq!(tree.cut(2), vec![vec![0], vec![1, 2, 3]]);
+    }
+
+    /// The concave share counts boundary edges whose endpoints' mean curvature sums to < 0,
+    /// by length; regions touch when they share an edge on at least half of the shapes.
+    #[test]
+    fn boundaries_measure_the_concave_share_and_touching() {
+        // A 4 × 1 strip of squares, x = 0..4, normals towards +z, folded along x = 2 by
+        // z = fold · |x − 2|; regions by x: 0 (x ≤ 1), 1 (x = 2), 2 (x ≥ 3). Flat (fold 0):
+        // H = 0 everywhere; a valley (fold 1): H < 0 on the crease, 0 on the planar slopes,
+        // so every boundary edge (each has a crease end) is concave; a ridge: none is.
+        let strip = |fold: f64| {
+            let p: Vec<[f64; 3]> = (0..10)
+                .map(|i| {
+                    let x = (i / 2) as f64;
+                    [x, (i % 2) as f64, fold * (x - 2.0).abs()]
+                })
+                .collect();
+            let f: Vec<[u32; 3]> = (0..4u32)
+                .flat_map(|k| {
+                    [
+                        [2 * k, 2 * k + 2, 2 * k + 1],
+                        [2 * k + 1, 2 * k + 2, 2 * k + 3],
+                    ]
+                })
+                .collect();
+            TriMesh::new(p, f).unwrap()
+        };
+        let tuple = |r: Vec<u32>| RegionTuple {
+            area_fractions: vec![0.0],
+            regions: vec![r],
+            sweeps: 0,
+            converged: true,
+            cycled: false,
+            objective: 0.0,
+            confidence: 1.0,
+            cycle_consistency: None,
+            leftover: false,
+        };
+        let coseg = Cosegmentation {
+            names: vec!["s".into()],
+            vertices: vec![10],
+            root: 0,
+            order: vec![0],
+            parent: vec![None],
+            alpha: 0.0,
+            tuples: vec![
+                tuple(vec![0, 1, 2, 3]),
+                tuple(vec![4, 5]),
+                tuple(vec![6, 7, 8, 9]),
+            ],
+        };
+        for (fold, share) in [(0.0, 0.0), (1.0, 1.0), (-1.0, 0.0)] {
+            let (touch, concave) = boundaries(&[strip(fold)], &coseg);
+            assert!(touch[0][1] && touch[1][2] && !touch[0][2]);
+            assert_eq!(
+                (concave[0][1], concave[1][2]),
+                (share, share),
+                "fold {fold}"
+            );
+            assert!(concave[0][2].is_nan());
+        }
+        // Two shapes, the valley and the flat strip: the upper median is the valley's share.
+        let two = Cosegmentation {
+            names: vec!["a".into(), "b".into()],
+            vertices: vec![10, 10],
+            order: vec![0, 1],
+            parent: vec![None, Some(0)],
+            tuples: coseg
+                .tuples
+                .iter()
+                .map(|t| RegionTuple {
+                    regions: vec![t.regions[0].clone(), t.regions[0].clone()],
+                    area_fractions: vec![0.0, 0.0],
+                    ..t.clone()
+                })
+                .collect(),
+            ..coseg.clone()
+        };
+        let (_, concave) = boundaries(&[strip(1.0), strip(0.0)], &two);
+        assert_eq!(concave[0][1], 1.0);
+    }
 }
