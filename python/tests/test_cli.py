@@ -120,6 +120,8 @@ def test_parts_starts_and_normals_match_the_cli(coseg_bin, chairs, tmp_path):
          dict(regions=5, parts=3, refine_sizes="keep:0.3")),
         (["--parts", "auto"], dict(parts="auto")),
         (["--regions", "3", "--starts", "2"], dict(regions=3, starts=2)),
+        (["--regions", "6", "--parts", "3", "--parts-from", "geometry"],
+         dict(regions=6, parts=3, parts_from="geometry")),
     ]
     for k, (flags, opts) in enumerate(runs):
         cli_out, py_out = tmp_path / f"cli{k}", tmp_path / f"py{k}"
@@ -135,7 +137,10 @@ def test_parts_starts_and_normals_match_the_cli(coseg_bin, chairs, tmp_path):
             assert r["summary"]["parts"]["region_leaves"]
             # Mirror pairs are compared on the spectral columns (a likeness) in both.
             assert all(p["likeness"] is not None for p in r["summary"]["parts"]["mirror_pairs"])
-            if opts["parts"] == 3:
+            if opts.get("parts_from") == "geometry":
+                assert r["summary"]["options"]["parts_from"] == {"kind": "geometry", "leaves": 6}
+                assert r["summary"]["parts"]["stop"] == {"reason": "equal_area_leaves"}
+            elif opts["parts"] == 3:
                 assert len(r["summary"]["parts"]["region_leaves"]) == 3
                 assert r["summary"]["options"]["refine_sizes"] == {"rule": "keep", "tolerance": 0.3}
         else:
@@ -156,6 +161,8 @@ def test_bad_parts_options_raise(chairs):
         (dict(refine_sizes="keep:-1"), "expected"),
         (dict(refine_sizes="tight"), "expected"),
         (dict(parts="auto", starts=3), "starts = 3"),  # several starts: equal-area mode only
+        (dict(parts="auto", parts_from="geometry"), "number of parts"),
+        (dict(parts=2, parts_from="size"), "expected"),
     ]
     for bad, message in cases:
         try:
