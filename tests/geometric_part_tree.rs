@@ -1,10 +1,13 @@
 //! Tests of the geometric part tree (`graph::geometric_part_tree`: thickness and boundary
 //! concavity) and of `--parts N --parts-from geometry` (`SegmentCollectionOptions::parts_from`).
 
+mod common;
+
+use common::graph::coseg_of;
 use coseg::bands::equal_count_bands;
 use coseg::graph::{
-    Cosegmentation, GraphError, PartsFrom, RegionTuple, SegmentCollectionOptions, ShapeNode,
-    StopReason, geometric_part_tree, segment_collection,
+    Cosegmentation, GraphError, PartsFrom, SegmentCollectionOptions, ShapeNode, StopReason,
+    geometric_part_tree, segment_collection,
 };
 use coseg::mesh::TriMesh;
 
@@ -58,36 +61,20 @@ fn column(
 
 /// A co-segmentation of one shape per mesh whose tuple `t` is the union of `groups[t]`'s rings.
 fn by_rings(meshes: &[TriMesh], rings: &[Vec<Vec<u32>>], groups: &[Vec<usize>]) -> Cosegmentation {
-    let n = meshes.len();
-    let tuples = groups
+    let parts: Vec<Vec<Vec<u32>>> = rings
         .iter()
-        .map(|g| RegionTuple {
-            area_fractions: vec![0.0; n],
-            regions: (0..n)
-                .map(|i| {
-                    let mut r: Vec<u32> = g.iter().flat_map(|&k| rings[i][k].clone()).collect();
-                    r.sort_unstable();
-                    r
+        .map(|r| {
+            groups
+                .iter()
+                .map(|g| {
+                    let mut v: Vec<u32> = g.iter().flat_map(|&k| r[k].clone()).collect();
+                    v.sort_unstable();
+                    v
                 })
-                .collect(),
-            sweeps: 0,
-            converged: true,
-            cycled: false,
-            objective: 0.0,
-            confidence: 1.0,
-            cycle_consistency: None,
-            leftover: false,
+                .collect()
         })
         .collect();
-    Cosegmentation {
-        names: (0..n).map(|i| format!("s{i}")).collect(),
-        vertices: meshes.iter().map(TriMesh::vertex_count).collect(),
-        root: 0,
-        order: (0..n).collect(),
-        parent: (0..n).map(|i| (i > 0).then_some(0)).collect(),
-        alpha: 0.0,
-        tuples,
-    }
+    coseg_of(meshes, &parts)
 }
 
 /// Three stepped columns of 24 rings, thick below ring 8 (radius 0.55–0.7) and thin above

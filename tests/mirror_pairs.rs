@@ -1,10 +1,12 @@
 //! Tests of the mirror-pair test (`graph::mirror_plane`, `graph::mirror_pairs`) and of the part
 //! tree that merges mirror pairs first (`AdaptiveCosegmentation::regroup`).
 
+mod common;
+
+use common::graph::coseg_of;
 use coseg::bands::BandTable;
 use coseg::graph::{
-    Cosegmentation, GraphOptions, Likeness, MirrorPlane, RegionTuple, ShapeGraph, ShapeNode,
-    mirror_pairs, mirror_plane,
+    GraphOptions, Likeness, MirrorPlane, ShapeGraph, ShapeNode, mirror_pairs, mirror_plane,
 };
 use coseg::mesh::TriMesh;
 
@@ -80,32 +82,6 @@ fn blocks(half: f64) -> (Vec<TriMesh>, Vec<Vec<Vec<u32>>>) {
             })
             .collect(),
     )
-}
-
-fn coseg_of(meshes: &[TriMesh], parts: &[Vec<Vec<u32>>]) -> Cosegmentation {
-    let n = meshes.len();
-    let tuples = (0..parts[0].len())
-        .map(|t| RegionTuple {
-            area_fractions: vec![0.0; n],
-            regions: parts.iter().map(|p| p[t].clone()).collect(),
-            sweeps: 0,
-            converged: true,
-            cycled: false,
-            objective: 0.0,
-            confidence: 1.0,
-            cycle_consistency: None,
-            leftover: false,
-        })
-        .collect();
-    Cosegmentation {
-        names: (0..n).map(|i| format!("s{i}")).collect(),
-        vertices: meshes.iter().map(TriMesh::vertex_count).collect(),
-        root: 0,
-        order: (0..n).collect(),
-        parent: (0..n).map(|i| (i > 0).then_some(0)).collect(),
-        alpha: 0.1,
-        tuples,
-    }
 }
 
 fn pairs(p: &[coseg::graph::MirrorPair]) -> Vec<(usize, usize)> {

@@ -26,7 +26,7 @@
 
 use super::{Cosegmentation, GraphError, PartMerge, PartTree};
 use crate::features::{SdfOptions, shape_diameter};
-use crate::mesh::TriMesh;
+use crate::mesh::{TriMesh, norm, sub};
 use rayon::prelude::*;
 
 /// The part tree of `coseg`'s tuples by thickness and boundary concavity (module docs).
@@ -109,7 +109,8 @@ pub fn geometric_part_tree(
     let l = coseg.tuples.len();
     if !coseg.matches(meshes) {
         return Err(GraphError::BadOption(
-            "thickness tree: one mesh per shape, with the shape's vertex count, is needed".into(),
+            "geometric part tree: one mesh per shape, with the shape's vertex count, is needed"
+                .into(),
         ));
     }
     let sdf = SdfOptions {
@@ -246,32 +247,37 @@ fn upper_median(mut v: Vec<f64>) -> f64 {
 /// (module docs; NaN where they do not touch).
 fn boundaries(meshes: &[TriMesh], coseg: &Cosegmentation) -> (Vec<Vec<bool>>, Vec<Vec<f64>>) {
     let l = coseg.tuples.len();
-    let mut shares: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); l]; l];
-    for (i, mesh) in meshes.iter().enumerate() {
-        let h = crate::features::mean_curvature(mesh);
-        let labels = coseg.labels(i);
-        let p = mesh.positions();
-        // (concave length, length) of each pair's boundary edges; an interior edge is seen
-        // from both of its faces, so both sums count it twice.
-        let mut len = vec![vec![(0.0, 0.0); l]; l];
-        for f in mesh.faces() {
-            for k in 0..3 {
-                let (u, v) = (f[k] as usize, f[(k + 1) % 3] as usize);
-                let (x, y) = (labels[u], labels[v]);
-                if x < 0 || y < 0 || x == y {
-                    continue;
-                }
-                let e = (0..3)
-                    .map(|c| (p[u][c] - p[v][c]).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
-                let c = if h[u] + h[v] < 0.0 { e } else { 0.0 };
-                for (a, b) in [(x as usize, y as usize), (y as usize, x as usize)] {
-                    len[a][b].0 += c;
-                    len[a][b].1 += e;
+    // Per shape (in parallel, one task each): (concave length, length) of each pair's
+    // boundary edges; an interior edge is seen from both of its faces, so both sums count it
+    // twice.
+    let lengths: Vec<Vec<Vec<(f64, f64)>>> = meshes
+        .par_iter()
+        .enumerate()
+        .map(|(i, mesh)| {
+            let h = crate::features::mean_curvature(mesh);
+            let labels = coseg.labels(i);
+            let p = mesh.positions();
+            let mut len = vec![vec![(0.0, 0.0); l]; l];
+            for f in mesh.faces() {
+                for k in 0..3 {
+                    let (u, v) = (f[k] as usize, f[(k + 1) % 3] as usize);
+                    let (x, y) = (labels[u], labels[v]);
+                    if x < 0 || y < 0 || x == y {
+                        continue;
+                    }
+                    let e = norm(sub(p[u], p[v]));
+                    let c = if h[u] + h[v] < 0.0 { e } else { 0.0 };
+                    for (a, b) in [(x as usize, y as usize), (y as usize, x as usize)] {
+                        len[a][b].0 += c;
+                        len[a][b].1 += e;
+                    }
                 }
             }
-        }
+            len
+        })
+        .collect();
+    let mut shares: Vec<Vec<Vec<f64>>> = vec![vec![Vec::new(); l]; l];
+    for len in &lengths {
         for (row, out) in len.iter().zip(shares.iter_mut()) {
             for (&(c, e), out) in row.iter().zip(out.iter_mut()) {
                 if e > 0.0 {

@@ -15,7 +15,7 @@
 
 use super::adaptive_cosegment::median;
 use super::{Cosegmentation, ShapeGraph};
-use crate::mesh::TriMesh;
+use crate::mesh::{TriMesh, dot, norm, sub};
 use serde::Serialize;
 use std::collections::HashMap;
 
@@ -45,9 +45,7 @@ impl MirrorPlane {
 
     /// `p` reflected across the plane.
     pub fn reflect(&self, p: [f64; 3]) -> [f64; 3] {
-        let d = (0..3)
-            .map(|k| (p[k] - self.point[k]) * self.normal[k])
-            .sum::<f64>();
+        let d = dot(sub(p, self.point), self.normal);
         [
             p[0] - 2.0 * d * self.normal[0],
             p[1] - 2.0 * d * self.normal[1],
@@ -183,7 +181,7 @@ impl Grid {
                         if let Some(vs) = self.cells.get(&[k[0] + dx, k[1] + dy, k[2] + dz]) {
                             for &v in vs {
                                 let p = pos[v as usize];
-                                let d = (0..3).map(|j| (p[j] - q[j]).powi(2)).sum::<f64>();
+                                let d = dot(sub(p, q), sub(p, q));
                                 best = best.min(d);
                             }
                         }
@@ -373,7 +371,7 @@ pub fn mirror_pairs(
                 .flatten()
                 .filter_map(|(reflection, c)| {
                     let ((ca, wa), (cb, wb)) = (c[a]?, c[b]?);
-                    let apart = dist(ca, cb);
+                    let apart = norm(sub(ca, cb));
                     if apart.is_nan() || apart <= 0.0 {
                         return None;
                     }
@@ -381,7 +379,10 @@ pub fn mirror_pairs(
                         Reflection::Vertical { point, up } => vertical_plane(point, up, ca, cb)?,
                         Reflection::Plane(plane) => plane,
                     };
-                    Some((dist(plane.reflect(ca), cb) / apart, wa.min(wb) / wa.max(wb)))
+                    Some((
+                        norm(sub(plane.reflect(ca), cb)) / apart,
+                        wa.min(wb) / wa.max(wb),
+                    ))
                 })
                 .unzip();
             if 2 * ratios.len() < n || ratios.is_empty() {
@@ -446,7 +447,7 @@ fn vertical_plane(
 }
 
 fn unit(v: [f64; 3]) -> Option<[f64; 3]> {
-    let len = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let len = norm(v);
     (len > 1e-12 * (1.0 + v.iter().map(|x| x.abs()).fold(0.0, f64::max)))
         .then(|| v.map(|x| x / len))
 }
@@ -461,7 +462,3 @@ enum Reflection {
 
 /// A shape's reflection and each tuple's area centroid and area on it (`None`: empty there).
 type ShapeCentroids = (Reflection, Vec<Option<([f64; 3], f64)>>);
-
-fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {
-    (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>().sqrt()
-}

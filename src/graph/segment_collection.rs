@@ -83,10 +83,11 @@ pub enum PartsFrom {
     /// transports between them ([`AdaptiveCosegmentation::regroup`]); refined after the cut.
     #[default]
     Adaptive,
-    /// `leaves` equal-area regions ([`cosegment`], refined), grouped by
+    /// `leaves` equal-area regions ([`cosegment`], refined freely: `refine_sizes` does not
+    /// apply, equal areas carry no sizes to keep), grouped by
     /// [`super::geometric_part_tree`]: touching regions (and mirror pairs) of one thickness
-    /// across convex boundaries merge first. Needs the meshes and a number of parts; no refinement after the cut (it would
-    /// drift the grouped parts back towards equal areas).
+    /// across convex boundaries merge first. Needs the meshes and a number of parts; no
+    /// refinement after the cut (it would drift the grouped parts back towards equal areas).
     Geometry {
         /// Number of equal-area regions (the finest parts; `coseg segment --regions`,
         /// default [`PartsFrom::GEOMETRY_LEAVES`]).
@@ -430,42 +431,20 @@ pub fn segment_collection(
     let mut start_scores = Vec::with_capacity(options.starts);
     for start in 0..options.starts {
         let t = Instant::now();
-        let mut leaf_refine = Duration::ZERO;
-        let (mut segmentation, adaptive) = match &options.parts {
-            Some(_) if geometry.is_some() => {
-                let (leaves, parts) = geometry.expect("checked");
+        let (mut segmentation, mut adaptive) = match (&options.parts, geometry) {
+            (_, Some((leaves, _))) => {
                 let mut o = options.cosegment;
                 o.regions = leaves;
-                let mut regions = cosegment(&graph, &o)?;
-                if let Some(refine) = refine {
-                    let t = Instant::now();
-                    regions = refine_cosegmentation_sized(
-                        &graph,
-                        &regions,
-                        smoothers.as_deref(),
-                        refine,
-                        RefineSizes::Free,
-                    )?;
-                    leaf_refine = t.elapsed();
-                }
-                let links = mirror_links(&graph, meshes, &regions, options);
-                let tree = geometric_part_tree(meshes, &regions, &links)?;
-                let a = AdaptiveCosegmentation {
-                    leaves: regions,
-                    auto: Vec::new(),
-                    stop: StopReason::EqualAreaLeaves,
-                    tree,
-                };
-                (a.cut(parts), Some(a))
+                (cosegment(&graph, &o)?, None)
             }
-            None => {
+            (None, None) => {
                 let mut o = options.cosegment;
                 if start > 0 {
                     o.seed = Some(o.seed.unwrap_or(0) + start as u64);
                 }
                 (cosegment(&graph, &o)?, None)
             }
-            Some(p) => {
+            (Some(p), None) => {
                 let mut a = adaptive_cosegment(&graph, p)?;
                 if options.group_mirrors {
                     let pairs = mirror_links(&graph, meshes, &a.leaves, options);
@@ -476,18 +455,38 @@ pub fn segment_collection(
                 (a.cut(p.parts.unwrap_or(usize::MAX)), Some(a))
             }
         };
-        times.cosegment += t.elapsed() - leaf_refine;
-        times.refine += leaf_refine;
-        if let Some(refine) = refine.filter(|_| geometry.is_none()) {
+        times.cosegment += t.elapsed();
+        if let Some(refine) = refine {
             let t = Instant::now();
+            // Equal-area leaves have no sizes from the data to keep.
+            let sizes = match geometry {
+                Some(_) => RefineSizes::Free,
+                None => options.refine_sizes,
+            };
             segmentation = refine_cosegmentation_sized(
                 &graph,
                 &segmentation,
                 smoothers.as_deref(),
                 refine,
-                options.refine_sizes,
+                sizes,
             )?;
             times.refine += t.elapsed();
+        }
+        // Parts from geometry: the refined equal-area regions are the leaves, cut after their
+        // refinement (a refinement of the grouped parts would drift them back to equal areas).
+        if let Some((_, parts)) = geometry {
+            let t = Instant::now();
+            let links = mirror_links(&graph, meshes, &segmentation, options);
+            let tree = geometric_part_tree(meshes, &segmentation, &links)?;
+            let a = AdaptiveCosegmentation {
+                leaves: segmentation,
+                auto: Vec::new(),
+                stop: StopReason::EqualAreaLeaves,
+                tree,
+            };
+            segmentation = a.cut(parts);
+            adaptive = Some(a);
+            times.cosegment += t.elapsed();
         }
         let score = start_score(&segmentation);
         start_scores.push(score);

@@ -1,6 +1,8 @@
 //! Fixtures for the shape-graph tests: structured band tables and vertex permutations.
 
 use coseg::bands::{BandTable, equal_count_bands};
+use coseg::graph::{Cosegmentation, RegionTuple};
+use coseg::mesh::TriMesh;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 
@@ -69,4 +71,33 @@ pub fn permute_values<T: Copy + Default>(x: &[T], perm: &[u32]) -> Vec<T> {
 pub fn random_weights(n: usize, seed: u64) -> Vec<f64> {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     (0..n).map(|_| 0.5 + uniform(&mut rng)).collect()
+}
+
+/// A co-segmentation of `meshes` (one shape each, a star graph rooted at shape 0) whose tuple
+/// `t` is region `parts[i][t]` on shape `i`: given regions, not found by the sweeps (area
+/// fractions 0, confidence 1).
+pub fn coseg_of(meshes: &[TriMesh], parts: &[Vec<Vec<u32>>]) -> Cosegmentation {
+    let n = meshes.len();
+    let tuples = (0..parts[0].len())
+        .map(|t| RegionTuple {
+            area_fractions: vec![0.0; n],
+            regions: parts.iter().map(|p| p[t].clone()).collect(),
+            sweeps: 0,
+            converged: true,
+            cycled: false,
+            objective: 0.0,
+            confidence: 1.0,
+            cycle_consistency: None,
+            leftover: false,
+        })
+        .collect();
+    Cosegmentation {
+        names: (0..n).map(|i| format!("s{i}")).collect(),
+        vertices: meshes.iter().map(TriMesh::vertex_count).collect(),
+        root: 0,
+        order: (0..n).collect(),
+        parent: (0..n).map(|i| (i > 0).then_some(0)).collect(),
+        alpha: 0.1,
+        tuples,
+    }
 }
