@@ -315,6 +315,7 @@ fn main() -> Res<()> {
         }
         o.up = pipeline.up_direction();
         o.mirror_columns = pipeline.mirror_invariant_columns(loaded.nodes[0].bands.features);
+        o.cue_cache = Some(cache.clone());
         if let Some(tolerance) = keep {
             o.refine_sizes = coseg::graph::RefineSizes::Keep { tolerance };
         }

@@ -27,6 +27,7 @@
 //! |---|---|---|---|
 //! | `<key>.coseg-shape` ([`EntryKind::Full`]) | [`crate::pipeline::StoredShape`] | eigenvalues (f64), eigenvectors (**f32**, `d × k`), vertex areas (f64), the sdf and user feature columns (f64) when those families are on, band table (u8 `d × N`, deflated inside the payload) | `4·d·k + 8·d + d·N/6` (10k vertices: 8.6 MB) |
 //! | `<key>.coseg-bands` ([`EntryKind::Bands`]) | [`crate::pipeline::ShapeBands`] | band table (u8, `d × N`), vertex areas (f64), the whole payload deflated | about `d·N / 6 + 8·d` (10k: 0.5 MB) |
+//! | `<key>.coseg-cues` ([`EntryKind::PartCues`], only with `--parts-from geometry`; key: the mesh and the SDF options, not the feature options) | [`crate::graph::PartCues`] | thickness and mean curvature (f64) | `16·d` (10k: 0.16 MB) |
 //!
 //! The descriptors (spectral and extrinsic) are not in the full entry: a warm load recomputes
 //! them from the stored spectrum with the cold run's own code
@@ -52,6 +53,8 @@ const HEADER_LEN: usize = 8 + 4 + 32 + 8 + 32;
 pub const CACHE_EXTENSION: &str = "coseg-shape";
 /// File extension of the compact bands entries ([`EntryKind::Bands`]).
 pub const BANDS_EXTENSION: &str = "coseg-bands";
+/// File extension of the part-cue entries ([`EntryKind::PartCues`]).
+pub const CUES_EXTENSION: &str = "coseg-cues";
 /// Deflate level of compressed payloads ([`EntryKind::compressed`]).
 const DEFLATE_LEVEL: u32 = 3;
 /// Deflate's largest expansion (a run of one byte: 258 bytes per 2-bit code, about 1032:1),
@@ -66,6 +69,9 @@ pub enum EntryKind {
     Full,
     /// The compact entry: band table and vertex areas only.
     Bands,
+    /// The geometric cues of part boundaries ([`crate::graph::PartCues`]: thickness and mean
+    /// curvature per vertex), for `--parts-from geometry`; keyed by the mesh alone.
+    PartCues,
 }
 
 impl EntryKind {
@@ -74,6 +80,7 @@ impl EntryKind {
         match self {
             EntryKind::Full => b"COSEGSHP",
             EntryKind::Bands => b"COSEGBND",
+            EntryKind::PartCues => b"COSEGCUE",
         }
     }
 
@@ -82,6 +89,7 @@ impl EntryKind {
         match self {
             EntryKind::Full => CACHE_EXTENSION,
             EntryKind::Bands => BANDS_EXTENSION,
+            EntryKind::PartCues => CUES_EXTENSION,
         }
     }
 

@@ -264,6 +264,26 @@ fn parts_from_geometry_is_recorded_and_checked() {
         2
     );
     assert_eq!(summary["regions"].as_array().unwrap().len(), 2);
+    // The part cues are cached beside the shapes' entries, one per shape; a rerun reads them
+    // and writes the same regions; a damaged entry is recomputed and rewritten as it was.
+    let cues: Vec<PathBuf> = std::fs::read_dir(out.join(".cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "coseg-cues"))
+        .collect();
+    assert_eq!(cues.len(), 3);
+    let regions = std::fs::read(out.join("s0.regions.txt")).unwrap();
+    let good = std::fs::read(&cues[0]).unwrap();
+    let mut bytes = good.clone();
+    bytes[100] ^= 1;
+    std::fs::write(&cues[0], &bytes).unwrap();
+    let (run, _) = run_with(
+        "t",
+        &["--parts", "2", "--parts-from", "geometry", "--regions", "5"],
+    );
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
+    assert_eq!(std::fs::read(&cues[0]).unwrap(), good);
+    assert_eq!(std::fs::read(out.join("s0.regions.txt")).unwrap(), regions);
     for (name, extra) in [
         ("auto", &["--parts", "auto", "--parts-from", "geometry"][..]),
         ("noparts", &["--parts-from", "geometry"][..]),

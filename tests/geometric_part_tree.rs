@@ -5,9 +5,11 @@ mod common;
 
 use common::graph::coseg_of;
 use coseg::bands::equal_count_bands;
+use coseg::cache::CacheOutcome;
 use coseg::graph::{
-    Cosegmentation, GraphError, PartsFrom, SegmentCollectionOptions, ShapeNode, StopReason,
-    geometric_part_tree, segment_collection,
+    Cosegmentation, GraphError, PartCues, PartsFrom, SegmentCollectionOptions, ShapeNode,
+    StopReason, geometric_part_tree, geometric_part_tree_with_cues, load_or_compute_part_cues,
+    segment_collection,
 };
 use coseg::mesh::TriMesh;
 
@@ -169,6 +171,18 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
     // Deterministic.
     let again = segment_collection(nodes.clone(), &meshes, &o).unwrap();
     assert_eq!(again.segmentation, out.segmentation);
+    // Through the cue cache: one entry per shape, the same parts bit for bit on the cold run
+    // and on the warm one, and nothing to warn about.
+    let dir = tempfile::tempdir().unwrap();
+    let mut cached = o.clone();
+    cached.cue_cache = Some(dir.path().to_path_buf());
+    for _ in 0..2 {
+        let run = segment_collection(nodes.clone(), &meshes, &cached).unwrap();
+        assert_eq!(run.segmentation, out.segmentation);
+        assert_eq!(run.adaptive.as_ref().unwrap().tree, a.tree);
+        assert!(run.warnings.is_empty(), "{:?}", run.warnings);
+        assert_eq!(cue_entries(dir.path()), 3);
+    }
     // A number of parts is needed, and enough regions to make them.
     o.request_parts(coseg::graph::PartsRequest::Auto, None);
     assert!(matches!(
@@ -186,4 +200,92 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
         segment_collection(nodes, &meshes, &none),
         Err(GraphError::BadOption(_))
     ));
+}
+
+/// The number of part-cue entries in a cache directory.
+fn cue_entries(dir: &std::path::Path) -> usize {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "coseg-cues")
+        })
+        .count()
+}
+
+#[test]
+fn part_cues_are_cached_bit_for_bit_and_a_bad_entry_is_recomputed() {
+    let (meshes, _) = stepped();
+    let m = &meshes[0];
+    let fresh = PartCues::of(m).unwrap();
+    assert_eq!(fresh.thickness.len(), m.vertex_count());
+    // The thick bottom is thicker than the thin top (radii 0.6 and 0.3).
+    let (bottom, top) = (fresh.thickness[8 * 4], fresh.thickness[8 * 20]);
+    assert!(bottom > 1.5 * top, "{bottom} {top}");
+    let dir = tempfile::tempdir().unwrap();
+    let first = load_or_compute_part_cues(m, dir.path()).unwrap();
+    assert_eq!(first.outcome, CacheOutcome::Miss);
+    assert_eq!(first.write_error, None);
+    let second = load_or_compute_part_cues(m, dir.path()).unwrap();
+    assert_eq!(second.outcome, CacheOutcome::Hit);
+    assert_eq!(second.cues, fresh);
+    let entry = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .next()
+        .unwrap();
+    assert!(entry.to_string_lossy().ends_with(".coseg-cues"));
+    // Another mesh, another entry.
+    load_or_compute_part_cues(&meshes[1], dir.path()).unwrap();
+    assert_eq!(cue_entries(dir.path()), 2);
+    // A damaged entry is not trusted: recomputed (the reason names the file) and replaced.
+    let mut bytes = std::fs::read(&entry).unwrap();
+    let n = bytes.len();
+    bytes[n - 1] ^= 1;
+    std::fs::write(&entry, &bytes).unwrap();
+    let third = load_or_compute_part_cues(m, dir.path()).unwrap();
+    match &third.outcome {
+        CacheOutcome::Recomputed { reason } => {
+            assert!(reason.contains(&entry.display().to_string()), "{reason}")
+        }
+        o => panic!("expected a recomputation, got {o:?}"),
+    }
+    assert_eq!(third.cues, fresh);
+    assert_eq!(
+        load_or_compute_part_cues(m, dir.path()).unwrap().outcome,
+        CacheOutcome::Hit
+    );
+    // A cache that cannot be written costs a warning, not the cues.
+    let file = dir.path().join("not-a-folder");
+    std::fs::write(&file, b"x").unwrap();
+    let r = load_or_compute_part_cues(m, &file).unwrap();
+    assert_eq!(r.cues, fresh);
+    assert!(r.write_error.unwrap().contains("not-a-folder"));
+}
+
+#[test]
+fn geometric_part_tree_with_cues_is_the_tree_and_refuses_cues_that_do_not_fit() {
+    let (meshes, rings) = stepped();
+    let groups: Vec<Vec<usize>> = (0..6).map(|t| (4 * t..4 * t + 4).collect()).collect();
+    let coseg = by_rings(&meshes, &rings, &groups);
+    let mut cues: Vec<PartCues> = meshes.iter().map(|m| PartCues::of(m).unwrap()).collect();
+    assert_eq!(
+        geometric_part_tree_with_cues(&meshes, &cues, &coseg, &[]).unwrap(),
+        geometric_part_tree(&meshes, &coseg, &[]).unwrap()
+    );
+    // The tree reads the cues it is given: a bottom as thin as the top joins it.
+    let tree = |cues: &[PartCues]| geometric_part_tree_with_cues(&meshes, cues, &coseg, &[]);
+    for c in &mut cues {
+        c.thickness = vec![1.0; c.thickness.len()];
+    }
+    assert_ne!(
+        tree(&cues).unwrap(),
+        geometric_part_tree(&meshes, &coseg, &[]).unwrap()
+    );
+    cues[1].thickness.pop();
+    assert!(matches!(tree(&cues), Err(GraphError::BadOption(_))));
+    assert!(matches!(tree(&cues[..2]), Err(GraphError::BadOption(_))));
 }

@@ -597,6 +597,7 @@ fn segment<'py>(
                 list.len()
             )));
         }
+        seg_opts.cue_cache = cache.clone();
         py.detach(|| load_arrays(list, &pipe, cache.as_deref()))
     } else {
         let folder: PathBuf = shapes.extract()?;
@@ -604,6 +605,7 @@ fn segment<'py>(
             Some(o) => o.join(".cache"),
             None => folder.join(".cache"),
         });
+        seg_opts.cue_cache = Some(cache.clone());
         py.detach(|| load_folder(&folder, &pipe, &cache))
     }
     .map_err(input_err)?;
@@ -632,6 +634,7 @@ fn segment<'py>(
     let mut summary = CollectionSummary::new(&result, &files, &seg_opts, skipped.clone());
     summary.parts = result.parts_report(&meshes);
     let mut warnings = warnings;
+    warnings.extend(result.warnings.iter().cloned());
     warnings.extend(summary.parts.as_ref().and_then(|p| p.warning()));
     let seg = &result.segmentation;
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();

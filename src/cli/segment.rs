@@ -12,7 +12,7 @@ use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions
 use coseg::pipeline::ShapePipelineOptions;
 use coseg::render::{RenderOptions, RenderShape};
 use coseg::stable::RefineOptions;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::time::{Duration, Instant};
 
@@ -139,11 +139,14 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             loaded.nodes.len()
         );
     }
-    let options = collection_options(&args, &pipeline, &loaded);
+    let options = collection_options(&args, &pipeline, &loaded, &cache);
     let spin = super::spinner("co-segmentation and refinement");
     let result = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?;
     if let Some(b) = spin {
         b.finish_and_clear();
+    }
+    for w in &result.warnings {
+        super::warn(w);
     }
     let seg = &result.segmentation;
     let t_write = Instant::now();
@@ -210,6 +213,7 @@ fn collection_options(
     args: &SegmentArgs,
     pipeline: &ShapePipelineOptions,
     loaded: &LoadedCollection,
+    cache: &Path,
 ) -> SegmentCollectionOptions {
     let mut o2 = SegmentCollectionOptions::default();
     o2.graph = {
@@ -242,6 +246,7 @@ fn collection_options(
     if let Some(from) = args.parts_from {
         o2.set_parts_from(from, args.regions);
     }
+    o2.cue_cache = Some(cache.to_path_buf());
     o2
 }
 
@@ -297,11 +302,15 @@ fn report(
     );
     let times = &result.times;
     println!(
-        "time: read {:.2} s, per-shape data {:.2} s ({hits} cached), graph {:.2} s, co-segmentation {:.2} s, refinement {:.2} s{}, write {:.2} s, total {:.2} s",
+        "time: read {:.2} s, per-shape data {:.2} s ({hits} cached), graph {:.2} s, co-segmentation {:.2} s{}, refinement {:.2} s{}, write {:.2} s, total {:.2} s",
         loaded.read_time.as_secs_f64(),
         loaded.shape_time.as_secs_f64(),
         times.graph.as_secs_f64(),
         times.cosegment.as_secs_f64(),
+        match times.part_cues {
+            Some(t) => format!(" (part cues {:.2} s)", t.as_secs_f64()),
+            None => String::new(),
+        },
         (times.smoothers + times.refine).as_secs_f64(),
         match (&options.refine, seg.tuples.first()) {
             (Some(_), Some(t)) => format!(

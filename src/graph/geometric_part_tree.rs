@@ -24,8 +24,7 @@
 //! 0 for linked regions that do not touch). Complete linkage on thickness keeps a group's
 //! thickness spread small. Each merge records the similarity `exp(−cost)` (1 = alike).
 
-use super::{Cosegmentation, GraphError, PartMerge, PartTree};
-use crate::features::{SdfOptions, shape_diameter};
+use super::{Cosegmentation, GraphError, PartCues, PartMerge, PartTree};
 use crate::mesh::{TriMesh, norm, sub};
 use rayon::prelude::*;
 
@@ -106,27 +105,67 @@ pub fn geometric_part_tree(
     coseg: &Cosegmentation,
     links: &[(usize, usize)],
 ) -> Result<PartTree, GraphError> {
-    let l = coseg.tuples.len();
-    if !coseg.matches(meshes) {
-        return Err(GraphError::BadOption(
-            "geometric part tree: one mesh per shape, with the shape's vertex count, is needed"
-                .into(),
-        ));
-    }
-    let sdf = SdfOptions {
-        smoothing_rounds: vec![1],
-        ..SdfOptions::default()
-    };
-    // ln_t[i][leaf]: the leaf's log thickness on shape i (NaN where the leaf is empty).
-    let ln_t: Vec<Vec<f64>> = meshes
+    check_meshes(meshes, coseg)?;
+    let cues = meshes
         .par_iter()
         .enumerate()
         .map(|(i, mesh)| {
-            let c = shape_diameter(mesh, &sdf).map_err(|source| GraphError::Thickness {
+            PartCues::of(mesh).map_err(|source| GraphError::Thickness {
                 name: coseg.names[i].clone(),
                 source,
-            })?;
-            let s = c.column(0);
+            })
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    geometric_part_tree_with_cues(meshes, &cues, coseg, links)
+}
+
+/// [`geometric_part_tree`] from cues already at hand (one [`PartCues`] per shape, graph order,
+/// e.g. from the cache by [`super::load_or_compute_part_cues`]): the same tree, bit for bit,
+/// without the SDF's cost.
+///
+/// Errors: [`GraphError::BadOption`] when the meshes or the cues do not match `coseg`.
+///
+/// ```
+/// use coseg::graph::{geometric_part_tree, geometric_part_tree_with_cues, Cosegmentation, PartCues, RegionTuple};
+/// use coseg::mesh::TriMesh;
+/// let p = vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
+/// let f = vec![[0,2,1],[0,3,2],[4,5,6],[4,6,7],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]];
+/// let mesh = TriMesh::new(p, f).unwrap();
+/// let tuple = |r: Vec<u32>| RegionTuple { area_fractions: vec![0.5], regions: vec![r],
+///     sweeps: 0, converged: true, cycled: false, objective: 0.0, confidence: 1.0,
+///     cycle_consistency: None, leftover: false };
+/// let coseg = Cosegmentation { names: vec!["cube".into()], vertices: vec![8], root: 0,
+///     order: vec![0], parent: vec![None], alpha: 0.5,
+///     tuples: vec![tuple(vec![0, 1, 2, 3]), tuple(vec![4, 5, 6, 7])] };
+/// let cues = vec![PartCues::of(&mesh).unwrap()];
+/// let with = geometric_part_tree_with_cues(&[mesh.clone()], &cues, &coseg, &[]).unwrap();
+/// assert_eq!(with, geometric_part_tree(&[mesh], &coseg, &[]).unwrap());
+/// ```
+pub fn geometric_part_tree_with_cues(
+    meshes: &[TriMesh],
+    cues: &[PartCues],
+    coseg: &Cosegmentation,
+    links: &[(usize, usize)],
+) -> Result<PartTree, GraphError> {
+    check_meshes(meshes, coseg)?;
+    if cues.len() != meshes.len()
+        || cues.iter().zip(meshes).any(|(c, m)| {
+            c.thickness.len() != m.vertex_count() || c.mean_curvature.len() != m.vertex_count()
+        })
+    {
+        return Err(GraphError::BadOption(
+            "geometric part tree: one set of part cues per shape, with the shape's vertex count, is needed"
+                .into(),
+        ));
+    }
+    let l = coseg.tuples.len();
+    // ln_t[i][leaf]: the leaf's log thickness on shape i (NaN where the leaf is empty).
+    let ln_t: Vec<Vec<f64>> = meshes
+        .iter()
+        .zip(cues)
+        .enumerate()
+        .map(|(i, (mesh, c))| {
+            let s = &c.thickness;
             let w = mesh.vertex_areas();
             let mut acc = vec![(0.0, 0.0); l];
             for (leaf, tuple) in coseg.tuples.iter().enumerate() {
@@ -136,12 +175,11 @@ pub fn geometric_part_tree(
                     acc[leaf].1 += w[v];
                 }
             }
-            Ok(acc
-                .iter()
+            acc.iter()
                 .map(|&(s, w)| if w > 0.0 { s / w } else { f64::NAN })
-                .collect())
+                .collect()
         })
-        .collect::<Result<_, GraphError>>()?;
+        .collect();
     let distance: Vec<Vec<f64>> = (0..l)
         .map(|a| {
             (0..l)
@@ -160,7 +198,7 @@ pub fn geometric_part_tree(
                 .collect()
         })
         .collect();
-    let (mut linked, concave) = boundaries(meshes, coseg);
+    let (mut linked, concave) = boundaries(meshes, cues, coseg);
     for &(a, b) in links {
         if a < l && b < l {
             linked[a][b] = true;
@@ -245,16 +283,21 @@ fn upper_median(mut v: Vec<f64>) -> f64 {
 /// For each pair of tuples: whether they share a mesh edge on at least half of the shapes,
 /// and then the (upper) median over those shapes of the concave share of their boundary
 /// (module docs; NaN where they do not touch).
-fn boundaries(meshes: &[TriMesh], coseg: &Cosegmentation) -> (Vec<Vec<bool>>, Vec<Vec<f64>>) {
+fn boundaries(
+    meshes: &[TriMesh],
+    cues: &[PartCues],
+    coseg: &Cosegmentation,
+) -> (Vec<Vec<bool>>, Vec<Vec<f64>>) {
     let l = coseg.tuples.len();
     // Per shape (in parallel, one task each): (concave length, length) of each pair's
     // boundary edges; an interior edge is seen from both of its faces, so both sums count it
     // twice.
     let lengths: Vec<Vec<Vec<(f64, f64)>>> = meshes
         .par_iter()
+        .zip(cues)
         .enumerate()
-        .map(|(i, mesh)| {
-            let h = crate::features::mean_curvature(mesh);
+        .map(|(i, (mesh, cues))| {
+            let h = &cues.mean_curvature;
             let labels = coseg.labels(i);
             let p = mesh.positions();
             let mut len = vec![vec![(0.0, 0.0); l]; l];
@@ -307,10 +350,33 @@ fn boundaries(meshes: &[TriMesh], coseg: &Cosegmentation) -> (Vec<Vec<bool>>, Ve
     (touch, concave)
 }
 
+fn check_meshes(meshes: &[TriMesh], coseg: &Cosegmentation) -> Result<(), GraphError> {
+    if coseg.matches(meshes) {
+        Ok(())
+    } else {
+        Err(GraphError::BadOption(
+            "geometric part tree: one mesh per shape, with the shape's vertex count, is needed"
+                .into(),
+        ))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::super::RegionTuple;
     use super::*;
+
+    /// Cues with the meshes' mean curvature and a constant thickness (the boundary tests
+    /// read only the curvature; the strips are open, so the SDF would not mean much).
+    fn curvature_only(meshes: &[TriMesh]) -> Vec<PartCues> {
+        meshes
+            .iter()
+            .map(|m| PartCues {
+                thickness: vec![1.0; m.vertex_count()],
+                mean_curvature: crate::features::mean_curvature(m),
+            })
+            .collect()
+    }
 
     /// A chain of four regions of one thickness, 0–1–2–3: the concave boundary (1, 2) is merged
     /// last, so two parts are {0, 1} and {2, 3}; with a convex one there it would not be.
@@ -393,7 +459,10 @@ mod tests {
             ],
         };
         for (fold, share) in [(0.0, 0.0), (1.0, 1.0), (-1.0, 0.0)] {
-            let (touch, concave) = boundaries(&[strip(fold)], &coseg);
+            let (touch, concave) = {
+                let m = [strip(fold)];
+                boundaries(&m, &curvature_only(&m), &coseg)
+            };
             assert!(touch[0][1] && touch[1][2] && !touch[0][2]);
             assert_eq!(
                 (concave[0][1], concave[1][2]),
@@ -419,7 +488,8 @@ mod tests {
                 .collect(),
             ..coseg.clone()
         };
-        let (_, concave) = boundaries(&[strip(1.0), strip(0.0)], &two);
+        let m = [strip(1.0), strip(0.0)];
+        let (_, concave) = boundaries(&m, &curvature_only(&m), &two);
         assert_eq!(concave[0][1], 1.0);
     }
 }

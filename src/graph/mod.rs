@@ -27,6 +27,7 @@ mod cycle_consistency;
 mod geometric_part_tree;
 mod load_collection;
 mod mirror_pairs;
+mod part_cues;
 mod refine_cosegmentation;
 mod segment_collection;
 mod shape_graph;
@@ -38,7 +39,7 @@ pub use adaptive_cosegment::{
 };
 pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
 pub use cycle_consistency::{CycleConsistency, cycle_consistency};
-pub use geometric_part_tree::geometric_part_tree;
+pub use geometric_part_tree::{geometric_part_tree, geometric_part_tree_with_cues};
 pub use load_collection::{
     LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
 };
@@ -46,6 +47,7 @@ pub use mirror_pairs::{
     Likeness, MIRROR_AREA_BALANCE, MIRROR_LIKENESS, MIRROR_PAIR_RATIO, MirrorPair, MirrorPlane,
     mirror_pairs, mirror_plane,
 };
+pub use part_cues::{PartCues, PartCuesResult, load_or_compute_part_cues};
 pub use refine_cosegmentation::{
     MIN_KEPT_SHARE, RefineSizes, refine_cosegmentation, refine_cosegmentation_sized,
 };

@@ -4,13 +4,16 @@
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    Likeness, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment,
-    geometric_part_tree, mirror_pairs, refine_cosegmentation_sized,
+    Likeness, PartCues, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment,
+    geometric_part_tree_with_cues, load_or_compute_part_cues, mirror_pairs,
+    refine_cosegmentation_sized,
 };
+use crate::cache::CacheOutcome;
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
 use crate::stable::RefineOptions;
 use rayon::prelude::*;
+use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
 /// Options of [`segment_collection`].
@@ -72,6 +75,12 @@ pub struct SegmentCollectionOptions {
     /// finest parts come from and how they are grouped (default [`PartsFrom::Adaptive`]).
     #[serde(skip_serializing_if = "PartsFrom::is_adaptive")]
     pub parts_from: PartsFrom,
+    /// With [`PartsFrom::Geometry`]: the per-shape cache directory where each shape's
+    /// [`super::PartCues`] are kept ([`super::load_or_compute_part_cues`]; `coseg segment` passes
+    /// its `--cache`). `None` (the default): computed every run. Not serialised: it does not
+    /// change the result.
+    #[serde(skip)]
+    pub cue_cache: Option<PathBuf>,
 }
 
 /// Where `--parts N` takes its finest parts from, and how it groups them
@@ -242,6 +251,7 @@ impl Default for SegmentCollectionOptions {
             up: None,
             mirror_columns: Vec::new(),
             parts_from: PartsFrom::Adaptive,
+            cue_cache: None,
         }
     }
 }
@@ -257,6 +267,9 @@ pub struct SegmentTimes {
     pub smoothers: Duration,
     /// [`refine_cosegmentation`](super::refine_cosegmentation).
     pub refine: Duration,
+    /// Reading or computing the [`super::PartCues`] (`None`: not needed, only
+    /// [`PartsFrom::Geometry`] reads them).
+    pub part_cues: Option<Duration>,
 }
 
 /// The result of [`segment_collection`].
@@ -278,6 +291,9 @@ pub struct SegmentedCollection {
     pub up: Option<[f64; 3]>,
     /// [`SegmentCollectionOptions::mirror_columns`], likewise.
     pub mirror_columns: Vec<usize>,
+    /// Warnings for the user: part-cue cache entries that were not trusted or not written
+    /// (the run's results do not depend on them).
+    pub warnings: Vec<String>,
 }
 
 impl SegmentedCollection {
@@ -427,6 +443,16 @@ pub fn segment_collection(
         _ => None,
     };
     times.smoothers = t.elapsed();
+    let mut warnings = Vec::new();
+    let cues = match geometry {
+        Some(_) => {
+            let t = Instant::now();
+            let cues = part_cues(&graph, meshes, options, &mut warnings)?;
+            times.part_cues = Some(t.elapsed());
+            Some(cues)
+        }
+        None => None,
+    };
     let mut best: Option<(f64, usize, Cosegmentation, Option<AdaptiveCosegmentation>)> = None;
     let mut start_scores = Vec::with_capacity(options.starts);
     for start in 0..options.starts {
@@ -477,7 +503,10 @@ pub fn segment_collection(
         if let Some((_, parts)) = geometry {
             let t = Instant::now();
             let links = mirror_links(&graph, meshes, &segmentation, options);
-            let tree = geometric_part_tree(meshes, &segmentation, &links)?;
+            let cues = cues
+                .as_deref()
+                .expect("computed above with parts from geometry");
+            let tree = geometric_part_tree_with_cues(meshes, cues, &segmentation, &links)?;
             let a = AdaptiveCosegmentation {
                 leaves: segmentation,
                 auto: Vec::new(),
@@ -504,5 +533,50 @@ pub fn segment_collection(
         start_scores,
         up: options.up,
         mirror_columns: options.mirror_columns.clone(),
+        warnings,
     })
+}
+
+/// Each shape's [`PartCues`], through [`SegmentCollectionOptions::cue_cache`] when set (cache
+/// problems become `warnings`), in parallel, one task per shape.
+fn part_cues(
+    graph: &ShapeGraph,
+    meshes: &[TriMesh],
+    options: &SegmentCollectionOptions,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<PartCues>, GraphError> {
+    if meshes.len() != graph.node_count() {
+        return Err(GraphError::BadOption(
+            "parts from geometry need one mesh per shape".into(),
+        ));
+    }
+    let got = meshes
+        .par_iter()
+        .enumerate()
+        .map(|(i, mesh)| {
+            let thickness = |source| GraphError::Thickness {
+                name: graph.node(i).name.clone(),
+                source,
+            };
+            match &options.cue_cache {
+                None => Ok((PartCues::of(mesh).map_err(thickness)?, Vec::new())),
+                Some(dir) => {
+                    let r = load_or_compute_part_cues(mesh, dir).map_err(thickness)?;
+                    let mut w = Vec::new();
+                    if let CacheOutcome::Recomputed { reason } = r.outcome {
+                        w.push(reason);
+                    }
+                    w.extend(r.write_error);
+                    Ok((r.cues, w))
+                }
+            }
+        })
+        .collect::<Result<Vec<_>, GraphError>>()?;
+    Ok(got
+        .into_iter()
+        .map(|(c, w)| {
+            warnings.extend(w);
+            c
+        })
+        .collect())
 }
