@@ -258,6 +258,7 @@ fn main() -> Res<()> {
     let mut normals = 0;
     let mut mirrors = false;
     let mut parts_from = None;
+    let mut snap_band: Option<f64> = None;
     while let Some(a) = args.next() {
         match a.as_str() {
             "--features" => features = args.next().ok_or("--features F")?,
@@ -275,6 +276,7 @@ fn main() -> Res<()> {
             }
             "--keep-sizes" => keep = Some(args.next().ok_or("--keep-sizes TOL")?.parse()?),
             "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),
+            "--snap-band" => snap_band = Some(args.next().ok_or("--snap-band W")?.parse()?),
             "--refine-rounds" => refine_rounds = args.next().ok_or("--refine-rounds N")?.parse()?,
             _ => modes.push(a),
         }
@@ -312,6 +314,9 @@ fn main() -> Res<()> {
                 .map(|(_, m)| m.parse())
                 .transpose()?;
             o.set_parts_from(from, leaves);
+            if let Some(b) = snap_band {
+                o.set_snap_band(b)?;
+            }
         }
         o.up = pipeline.up_direction();
         o.mirror_columns = pipeline.mirror_invariant_columns(loaded.nodes[0].bands.features);

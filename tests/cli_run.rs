@@ -255,7 +255,7 @@ fn parts_from_geometry_is_recorded_and_checked() {
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     assert_eq!(
         summary["options"]["parts_from"],
-        serde_json::json!({"kind": "geometry", "leaves": 5})
+        serde_json::json!({"kind": "geometry", "leaves": 5, "band": 0.1})
     );
     assert_eq!(summary["parts"]["stop"]["reason"], "equal_area_leaves");
     assert_eq!(summary["parts"]["leaf_areas"].as_array().unwrap().len(), 5);

@@ -152,7 +152,9 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
         .collect();
     let mut o = SegmentCollectionOptions::default();
     o.request_parts(coseg::graph::PartsRequest::Count(2), None);
-    o.set_parts_from(PartsFrom::Geometry { leaves: 12 }, Some(6));
+    o.set_parts_from("geometry".parse().unwrap(), Some(6));
+    // The tree's cut as it is: the boundary snapping is tested on its own.
+    o.set_snap_band(0.0).unwrap();
     let out = segment_collection(nodes.clone(), &meshes, &o).unwrap();
     let a = out.adaptive.as_ref().unwrap();
     assert_eq!(a.stop, StopReason::EqualAreaLeaves);
@@ -195,7 +197,10 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
         Err(GraphError::BadOption(_))
     ));
     let mut none = SegmentCollectionOptions::default();
-    none.parts_from = PartsFrom::Geometry { leaves: 6 };
+    none.parts_from = PartsFrom::Geometry {
+        leaves: 6,
+        band: PartsFrom::GEOMETRY_BAND,
+    };
     assert!(matches!(
         segment_collection(nodes, &meshes, &none),
         Err(GraphError::BadOption(_))

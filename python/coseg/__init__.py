@@ -425,6 +425,7 @@ def segment(
     starts: int = _D["starts"],
     refine_sizes: str = _D["refine_sizes"],
     parts_from: str = _D["parts_from"],
+    snap_band: Optional[float] = None,
     area_fraction: Optional[float] = _D["area_fraction"],
     seed: Optional[int] = _D["segment_seed"],
     complete_limit: int = _D["complete_limit"],
@@ -466,7 +467,8 @@ def segment(
     area before refinement (meant for ``parts``); ``parts_from`` (``"adaptive"``): with
     ``parts=N``, ``"geometry"`` takes ``regions`` (default 12) equal-area regions and groups
     touching ones (and left/right copies) of one thickness across convex boundaries (``--parts-from geometry``,
-    docs/PARTS.md); ``area_fraction`` (None: 1 / regions) of
+    docs/PARTS.md), then moves each part boundary onto a concave crease within ``snap_band``
+    (None: 0.1) × √(shape area) (``--snap-band``; 0 keeps the regions' boundaries); ``area_fraction`` (None: 1 / regions) of
     each region; ``seed`` (None: start from the most distinctive vertex); ``complete_limit``
     (12): collections up to this size use a complete shape graph, larger ones ``neighbours``
     (6) nearest neighbours; ``refine_rounds`` (boundary refinement sweeps, 0 = none) and
@@ -484,6 +486,7 @@ def segment(
         starts=starts,
         refine_sizes=refine_sizes,
         parts_from=parts_from,
+        snap_band=snap_band,
         area_fraction=area_fraction,
         seed=seed,
         complete_limit=complete_limit,

@@ -186,6 +186,7 @@ impl<'py> Opts<'py> {
         let starts: Option<usize> = self.take("starts")?;
         let sizes: Option<String> = self.take("refine_sizes")?;
         let from: Option<String> = self.take("parts_from")?;
+        let snap_band: Option<f64> = self.take("snap_band")?;
         let lib = |e: GraphError| super::lib_err(&e);
         let mut o2 = d;
         if let Some(v) = upper_bound {
@@ -210,6 +211,9 @@ impl<'py> Opts<'py> {
         }
         if let Some(f) = from {
             o2.set_parts_from(f.parse::<PartsFrom>().map_err(lib)?, upper_bound);
+        }
+        if let Some(b) = snap_band {
+            o2.set_snap_band(b).map_err(lib)?;
         }
         Ok(o2)
     }

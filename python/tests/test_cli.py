@@ -122,6 +122,8 @@ def test_parts_starts_and_normals_match_the_cli(coseg_bin, chairs, tmp_path):
         (["--regions", "3", "--starts", "2"], dict(regions=3, starts=2)),
         (["--regions", "6", "--parts", "3", "--parts-from", "geometry"],
          dict(regions=6, parts=3, parts_from="geometry")),
+        (["--regions", "6", "--parts", "3", "--parts-from", "geometry", "--snap-band", "0.05"],
+         dict(regions=6, parts=3, parts_from="geometry", snap_band=0.05)),
     ]
     for k, (flags, opts) in enumerate(runs):
         cli_out, py_out = tmp_path / f"cli{k}", tmp_path / f"py{k}"
@@ -138,7 +140,9 @@ def test_parts_starts_and_normals_match_the_cli(coseg_bin, chairs, tmp_path):
             # Mirror pairs are compared on the spectral columns (a likeness) in both.
             assert all(p["likeness"] is not None for p in r["summary"]["parts"]["mirror_pairs"])
             if opts.get("parts_from") == "geometry":
-                assert r["summary"]["options"]["parts_from"] == {"kind": "geometry", "leaves": 6}
+                band = opts.get("snap_band", 0.1)
+                assert r["summary"]["options"]["parts_from"] == {
+                    "kind": "geometry", "leaves": 6, "band": band}
                 assert r["summary"]["parts"]["stop"] == {"reason": "equal_area_leaves"}
             elif opts["parts"] == 3:
                 assert len(r["summary"]["parts"]["region_leaves"]) == 3
@@ -163,6 +167,8 @@ def test_bad_parts_options_raise(chairs):
         (dict(parts="auto", starts=3), "starts = 3"),  # several starts: equal-area mode only
         (dict(parts="auto", parts_from="geometry"), "number of parts"),
         (dict(parts=2, parts_from="size"), "expected"),
+        (dict(parts=2, snap_band=0.1), "parts from geometry"),  # the band is geometry's
+        (dict(parts=2, parts_from="geometry", snap_band=-1.0), "finite value"),
     ]
     for bad, message in cases:
         try:

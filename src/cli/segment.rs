@@ -47,6 +47,10 @@ pub struct SegmentArgs {
     /// have one thickness and meet over convex surface; docs/PARTS.md).
     #[arg(long, value_parser = parse_parts_from)]
     parts_from: Option<PartsFrom>,
+    /// With `--parts-from geometry`: how far each part boundary may move onto a concave
+    /// crease, × √(shape area) (default 0.1; 0 keeps the regions' boundaries; docs/PARTS.md).
+    #[arg(long)]
+    snap_band: Option<f64>,
     /// Area of each region as a fraction of its shape (default: 1 / regions).
     #[arg(long)]
     area_fraction: Option<f64>,
@@ -139,7 +143,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
             loaded.nodes.len()
         );
     }
-    let options = collection_options(&args, &pipeline, &loaded, &cache);
+    let options = collection_options(&args, &pipeline, &loaded, &cache)?;
     let spin = super::spinner("co-segmentation and refinement");
     let result = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?;
     if let Some(b) = spin {
@@ -214,7 +218,7 @@ fn collection_options(
     pipeline: &ShapePipelineOptions,
     loaded: &LoadedCollection,
     cache: &Path,
-) -> SegmentCollectionOptions {
+) -> Result<SegmentCollectionOptions> {
     let mut o2 = SegmentCollectionOptions::default();
     o2.graph = {
         let mut opts = GraphOptions::default();
@@ -246,8 +250,11 @@ fn collection_options(
     if let Some(from) = args.parts_from {
         o2.set_parts_from(from, args.regions);
     }
+    if let Some(band) = args.snap_band {
+        o2.set_snap_band(band)?;
+    }
     o2.cue_cache = Some(cache.to_path_buf());
-    o2
+    Ok(o2)
 }
 
 /// preview.png, <name>.png and index.html, legends naming each region by its confidence.

@@ -44,6 +44,7 @@ pub use heat_kernel_signature::heat_kernel_signature;
 pub use mean_curvature::mean_curvature;
 pub use multiscale_mean_curvature::multiscale_mean_curvature;
 pub use scale_grid::{ScaleGrid, SpectralBand, scale_grid};
+pub(crate) use sdf::inward_wound;
 pub use sdf::{SdfOptions, shape_diameter};
 pub use user::{read_user_features, user_feature_path};
 pub use wave_kernel_signature::wave_kernel_signature;

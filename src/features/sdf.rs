@@ -113,7 +113,7 @@ fn basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
 
 /// Per vertex: does its connected component enclose a negative signed volume (faces wound
 /// inwards)? Such components get their normals flipped so that every normal points outwards.
-fn inward_wound(mesh: &TriMesh) -> Vec<bool> {
+pub(crate) fn inward_wound(mesh: &TriMesh) -> Vec<bool> {
     let comps = connected_components(mesh);
     let mut volume = vec![0.0f64; comps.count];
     let p = mesh.positions();

@@ -31,6 +31,7 @@ mod part_cues;
 mod refine_cosegmentation;
 mod segment_collection;
 mod shape_graph;
+mod snap_part_boundaries;
 mod stable_cycle;
 
 pub use adaptive_cosegment::{
@@ -56,6 +57,7 @@ pub use segment_collection::{
     segment_collection, start_score,
 };
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
+pub use snap_part_boundaries::snap_part_boundaries;
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
 };
