@@ -312,24 +312,8 @@ struct OneRing {
 impl OneRing {
     fn new(mesh: &TriMesh) -> Self {
         let (edges, _) = crate::mesh::edges(mesh);
-        let d = mesh.vertex_count();
-        let mut degree = vec![0usize; d + 1];
-        for e in &edges {
-            degree[e[0] as usize + 1] += 1;
-            degree[e[1] as usize + 1] += 1;
-        }
-        for v in 0..d {
-            degree[v + 1] += degree[v];
-        }
-        let offsets = degree.clone();
-        let mut fill = degree;
-        let mut neighbours = vec![0u32; edges.len() * 2];
-        for e in &edges {
-            neighbours[fill[e[0] as usize]] = e[1];
-            fill[e[0] as usize] += 1;
-            neighbours[fill[e[1] as usize]] = e[0];
-            fill[e[1] as usize] += 1;
-        }
+        let (offsets, adjacent) = crate::mesh::edge_adjacency(mesh.vertex_count(), &edges);
+        let neighbours = adjacent.into_iter().map(|(u, _)| u).collect();
         Self {
             offsets,
             neighbours,

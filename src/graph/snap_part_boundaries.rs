@@ -10,7 +10,7 @@
 //! cuts near a boundary the one running along concave edges is the likeliest part boundary.
 
 use super::{Cosegmentation, GraphError};
-use crate::mesh::{TriMesh, dot, norm, sub};
+use crate::mesh::{TriMesh, dot, edge_adjacency, norm, sub};
 use rayon::prelude::*;
 use std::cmp::Ordering;
 use std::collections::{BinaryHeap, VecDeque};
@@ -218,23 +218,7 @@ fn snap_shape(mesh: &TriMesh, labels: &[i32], band: f64) -> Vec<i32> {
     let d = mesh.vertex_count();
     let (edges, weight, length) = edge_weights(mesh);
     let p = mesh.positions();
-    // Adjacency (CSR): neighbour, edge index.
-    let mut deg = vec![0usize; d + 1];
-    for e in &edges {
-        deg[e[0] as usize + 1] += 1;
-        deg[e[1] as usize + 1] += 1;
-    }
-    for v in 0..d {
-        deg[v + 1] += deg[v];
-    }
-    let mut fill = deg.clone();
-    let mut adj = vec![(0u32, 0u32); edges.len() * 2];
-    for (k, e) in edges.iter().enumerate() {
-        adj[fill[e[0] as usize]] = (e[1], k as u32);
-        fill[e[0] as usize] += 1;
-        adj[fill[e[1] as usize]] = (e[0], k as u32);
-        fill[e[1] as usize] += 1;
-    }
+    let (deg, adj) = edge_adjacency(d, &edges);
     let radius = band * mesh.total_area().sqrt();
     let mut labels = labels.to_vec();
     let parts = labels.iter().copied().max().unwrap_or(-1) + 1;

@@ -18,7 +18,7 @@ pub use io::{
     MeshFormat, PlyVertexProperty, read_mesh, read_mesh_from_bytes, read_mesh_with_report,
     write_atomic, write_mesh,
 };
-pub use topology::{Components, boundary_edges, connected_components, edges};
+pub use topology::{Components, boundary_edges, connected_components, edge_adjacency, edges};
 pub use validate::{MeshReport, MeshWarning};
 
 /// Errors raised while reading, writing or building a mesh. Every variant that concerns a file

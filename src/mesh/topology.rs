@@ -28,6 +28,38 @@ pub fn edges(mesh: &TriMesh) -> (Vec<[u32; 2]>, Vec<u32>) {
     (unique, counts)
 }
 
+/// The vertex graph of `edges` (as [`edges`] lists them) over `d` vertices, compressed: the
+/// neighbours of vertex `v` are `adjacent[offsets[v]..offsets[v + 1]]`, each with the index of
+/// the edge joining them, in edge order. `offsets` has `d + 1` entries.
+///
+/// ```
+/// use coseg::mesh::{edge_adjacency, edges, TriMesh};
+/// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[0.,1.,0.]], vec![[0, 1, 2]]).unwrap();
+/// let (e, _) = edges(&m);
+/// let (offsets, adjacent) = edge_adjacency(3, &e);
+/// assert_eq!(offsets, [0, 2, 4, 6]);
+/// assert_eq!(&adjacent[offsets[1]..offsets[2]], &[(0, 0), (2, 2)]);
+/// ```
+pub fn edge_adjacency(d: usize, edges: &[[u32; 2]]) -> (Vec<usize>, Vec<(u32, u32)>) {
+    let mut offsets = vec![0usize; d + 1];
+    for e in edges {
+        offsets[e[0] as usize + 1] += 1;
+        offsets[e[1] as usize + 1] += 1;
+    }
+    for v in 0..d {
+        offsets[v + 1] += offsets[v];
+    }
+    let mut fill = offsets.clone();
+    let mut adjacent = vec![(0u32, 0u32); edges.len() * 2];
+    for (k, e) in edges.iter().enumerate() {
+        for (a, b) in [(e[0], e[1]), (e[1], e[0])] {
+            adjacent[fill[a as usize]] = (b, k as u32);
+            fill[a as usize] += 1;
+        }
+    }
+    (offsets, adjacent)
+}
+
 /// Edges that belong to exactly one face, as `(i, j)` with `i < j`, sorted.
 pub fn boundary_edges(mesh: &TriMesh) -> Vec<[u32; 2]> {
     let (e, c) = edges(mesh);
