@@ -3,13 +3,14 @@
 //! ```text
 //! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N]
 //!     [--features F --up AXIS [--normals N]] [--starts N] [--keep-sizes TOL] [--detail]
-//!     [--parts-from adaptive|geometry] MODE...
+//!     [--parts-from adaptive|geometry [--snap-band W]] MODE...
 //! ```
 //! `--features`/`--up`/`--normals` select the feature families as `coseg segment` does (e.g.
 //! `--features spectral,extrinsic --up y --normals 16`), `--starts` its several starts, `--keep-sizes TOL`
 //! the size-aware refinement (`RefineSizes::Keep`, `coseg segment --refine-sizes keep:TOL`;
 //! without it the free best response), `--parts-from` where `parts:N` takes its finest parts
-//! (`coseg segment --parts-from`; with `geometry`, `@max=R` is the number of regions).
+//! (`coseg segment --parts-from`; with `geometry`, `@max=R` is the number of regions and
+//! `--snap-band W` the band of the boundary snapping, `coseg segment --snap-band`).
 //! `--detail` prints, for families, each shape's own purity / coverage, the pooled area table
 //! (region × grouped part, % of a shape) and the best any grouping of the regions could score.
 //! `FOLDER` is either a COSEG-style set (`shapes/N.off` and `gt/N.seg`, one label per face) or a
