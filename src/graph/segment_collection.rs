@@ -257,6 +257,16 @@ impl SegmentCollectionOptions {
     ///
     /// Errors: [`GraphError::BadOption`] when the parts do not come from geometry or the band
     /// is negative or not finite.
+    ///
+    /// ```
+    /// use coseg::graph::{PartsFrom, SegmentCollectionOptions};
+    /// let mut o = SegmentCollectionOptions::default();
+    /// assert!(o.set_snap_band(0.1).is_err()); // adaptive parts have no band
+    /// o.set_parts_from("geometry".parse().unwrap(), None);
+    /// o.set_snap_band(0.0).unwrap(); // the regions' boundaries as they are
+    /// assert_eq!(o.parts_from, PartsFrom::Geometry { leaves: 12, band: 0.0 });
+    /// assert!(o.set_snap_band(-1.0).is_err());
+    /// ```
     pub fn set_snap_band(&mut self, band: f64) -> Result<(), GraphError> {
         if !(band.is_finite() && band >= 0.0) {
             return Err(GraphError::BadOption(format!(
