@@ -106,16 +106,8 @@ pub fn geometric_part_tree(
     links: &[(usize, usize)],
 ) -> Result<PartTree, GraphError> {
     check_meshes(meshes, coseg)?;
-    let cues = meshes
-        .par_iter()
-        .enumerate()
-        .map(|(i, mesh)| {
-            PartCues::of(mesh).map_err(|source| GraphError::Thickness {
-                name: coseg.names[i].clone(),
-                source,
-            })
-        })
-        .collect::<Result<Vec<_>, _>>()?;
+    let name = |i: usize| coseg.names[i].clone();
+    let cues = super::part_cues::collection_cues(meshes, name, None, &mut Vec::new())?;
     geometric_part_tree_with_cues(meshes, &cues, coseg, links)
 }
 

@@ -8,10 +8,12 @@
 //! run on it (docs/PARTS.md). The cues depend on the mesh alone, not on the feature options,
 //! so one entry serves every run on that mesh.
 
+use super::GraphError;
 use crate::cache::{CacheOutcome, EntryKind, Lookup, entry_key, entry_path, read_entry};
 use crate::cache::{encode_entry, write_entry};
 use crate::features::{FeatureError, SdfOptions, mean_curvature, shape_diameter};
 use crate::mesh::TriMesh;
+use rayon::prelude::*;
 use std::path::Path;
 
 /// One shape's geometric cues of part boundaries, per vertex (each #V long).
@@ -142,4 +144,44 @@ pub fn load_or_compute_part_cues(
         outcome,
         write_error,
     })
+}
+
+/// Each shape's cues (in parallel, one task per shape), through the cache in `cache_dir` when
+/// given; untrusted or unwritten entries become `warnings`. `name(i)` names shape `i` in the
+/// error of a shape whose SDF fails ([`GraphError::Thickness`]).
+pub(crate) fn collection_cues(
+    meshes: &[TriMesh],
+    name: impl Fn(usize) -> String + Sync,
+    cache_dir: Option<&Path>,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<PartCues>, GraphError> {
+    let got = meshes
+        .par_iter()
+        .enumerate()
+        .map(|(i, mesh)| {
+            let thickness = |source| GraphError::Thickness {
+                name: name(i),
+                source,
+            };
+            match cache_dir {
+                None => Ok((PartCues::of(mesh).map_err(thickness)?, Vec::new())),
+                Some(dir) => {
+                    let r = load_or_compute_part_cues(mesh, dir).map_err(thickness)?;
+                    let mut w = Vec::new();
+                    if let CacheOutcome::Recomputed { reason } = r.outcome {
+                        w.push(reason);
+                    }
+                    w.extend(r.write_error);
+                    Ok((r.cues, w))
+                }
+            }
+        })
+        .collect::<Result<Vec<_>, GraphError>>()?;
+    Ok(got
+        .into_iter()
+        .map(|(c, w)| {
+            warnings.extend(w);
+            c
+        })
+        .collect())
 }

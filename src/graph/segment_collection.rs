@@ -1,14 +1,14 @@
 //! [`segment_collection`]: the whole collection stage in one call (shape graph →
 //! [`cosegment`] → heat smoothers → [`refine_cosegmentation`]), as `coseg segment` runs it.
 
+use super::part_cues::collection_cues;
 use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
+use super::snap_part_boundaries::check_band;
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    Likeness, PartCues, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment,
-    geometric_part_tree_with_cues, load_or_compute_part_cues, mirror_pairs,
-    refine_cosegmentation_sized, snap_part_boundaries,
+    Likeness, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment,
+    geometric_part_tree_with_cues, mirror_pairs, refine_cosegmentation_sized, snap_part_boundaries,
 };
-use crate::cache::CacheOutcome;
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
 use crate::stable::RefineOptions;
@@ -268,11 +268,7 @@ impl SegmentCollectionOptions {
     /// assert!(o.set_snap_band(-1.0).is_err());
     /// ```
     pub fn set_snap_band(&mut self, band: f64) -> Result<(), GraphError> {
-        if !(band.is_finite() && band >= 0.0) {
-            return Err(GraphError::BadOption(format!(
-                "snap band {band}: expected a finite value ≥ 0"
-            )));
-        }
+        check_band(band)?;
         match &mut self.parts_from {
             PartsFrom::Geometry { band: b, .. } => {
                 *b = band;
@@ -470,11 +466,7 @@ pub fn segment_collection(
                     "parts from geometry: {leaves} regions cannot make {parts} parts"
                 )));
             }
-            if !(band.is_finite() && band >= 0.0) {
-                return Err(GraphError::BadOption(format!(
-                    "snap band {band}: expected a finite value ≥ 0"
-                )));
-            }
+            check_band(band)?;
             Some((leaves, parts, band))
         }
         _ => None,
@@ -500,7 +492,13 @@ pub fn segment_collection(
     let cues = match geometry {
         Some(_) => {
             let t = Instant::now();
-            let cues = part_cues(&graph, meshes, options, &mut warnings)?;
+            if meshes.len() != graph.node_count() {
+                return Err(GraphError::BadOption(
+                    "parts from geometry need one mesh per shape".into(),
+                ));
+            }
+            let name = |i: usize| graph.node(i).name.clone();
+            let cues = collection_cues(meshes, name, options.cue_cache.as_deref(), &mut warnings)?;
             times.part_cues = Some(t.elapsed());
             Some(cues)
         }
@@ -567,10 +565,7 @@ pub fn segment_collection(
                 stop: StopReason::EqualAreaLeaves,
                 tree,
             };
-            segmentation = a.cut(parts);
-            if band > 0.0 {
-                segmentation = snap_part_boundaries(meshes, &segmentation, band)?;
-            }
+            segmentation = snap_part_boundaries(meshes, &a.cut(parts), band)?;
             adaptive = Some(a);
             times.cosegment += t.elapsed();
         }
@@ -592,48 +587,4 @@ pub fn segment_collection(
         mirror_columns: options.mirror_columns.clone(),
         warnings,
     })
-}
-
-/// Each shape's [`PartCues`], through [`SegmentCollectionOptions::cue_cache`] when set (cache
-/// problems become `warnings`), in parallel, one task per shape.
-fn part_cues(
-    graph: &ShapeGraph,
-    meshes: &[TriMesh],
-    options: &SegmentCollectionOptions,
-    warnings: &mut Vec<String>,
-) -> Result<Vec<PartCues>, GraphError> {
-    if meshes.len() != graph.node_count() {
-        return Err(GraphError::BadOption(
-            "parts from geometry need one mesh per shape".into(),
-        ));
-    }
-    let got = meshes
-        .par_iter()
-        .enumerate()
-        .map(|(i, mesh)| {
-            let thickness = |source| GraphError::Thickness {
-                name: graph.node(i).name.clone(),
-                source,
-            };
-            match &options.cue_cache {
-                None => Ok((PartCues::of(mesh).map_err(thickness)?, Vec::new())),
-                Some(dir) => {
-                    let r = load_or_compute_part_cues(mesh, dir).map_err(thickness)?;
-                    let mut w = Vec::new();
-                    if let CacheOutcome::Recomputed { reason } = r.outcome {
-                        w.push(reason);
-                    }
-                    w.extend(r.write_error);
-                    Ok((r.cues, w))
-                }
-            }
-        })
-        .collect::<Result<Vec<_>, GraphError>>()?;
-    Ok(got
-        .into_iter()
-        .map(|(c, w)| {
-            warnings.extend(w);
-            c
-        })
-        .collect())
 }

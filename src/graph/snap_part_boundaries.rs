@@ -109,11 +109,7 @@ pub fn snap_part_boundaries(
                 .into(),
         ));
     }
-    if !(band.is_finite() && band >= 0.0) {
-        return Err(GraphError::BadOption(format!(
-            "snap band {band}: expected a finite value ≥ 0"
-        )));
-    }
+    check_band(band)?;
     if band == 0.0 {
         return Ok(coseg.clone());
     }
@@ -134,6 +130,17 @@ pub fn snap_part_boundaries(
         }
     }
     Ok(out)
+}
+
+/// The band's one rule, shared with the options that carry it: finite and ≥ 0.
+pub(crate) fn check_band(band: f64) -> Result<(), GraphError> {
+    if band.is_finite() && band >= 0.0 {
+        Ok(())
+    } else {
+        Err(GraphError::BadOption(format!(
+            "snap band {band}: expected a finite value ≥ 0"
+        )))
+    }
 }
 
 /// Per edge (sorted pairs): its cut weight ([`snap_part_boundaries`]).
@@ -217,7 +224,6 @@ fn edge_weights(mesh: &TriMesh) -> (Vec<[u32; 2]>, Vec<f64>, Vec<f64>) {
 fn snap_shape(mesh: &TriMesh, labels: &[i32], band: f64) -> Vec<i32> {
     let d = mesh.vertex_count();
     let (edges, weight, length) = edge_weights(mesh);
-    let p = mesh.positions();
     let (deg, adj) = edge_adjacency(d, &edges);
     let radius = band * mesh.total_area().sqrt();
     let mut labels = labels.to_vec();
@@ -247,12 +253,12 @@ fn snap_shape(mesh: &TriMesh, labels: &[i32], band: f64) -> Vec<i32> {
                 if dv > dist[v] {
                     continue;
                 }
-                for &(u, _) in &adj[deg[v]..deg[v + 1]] {
+                for &(u, e) in &adj[deg[v]..deg[v + 1]] {
                     let u = u as usize;
                     if labels[u] != a && labels[u] != b {
                         continue;
                     }
-                    let du = dv + norm(sub(p[u], p[v]));
+                    let du = dv + length[e as usize];
                     if du <= radius && du < dist[u] {
                         dist[u] = du;
                         heap.push(Near(du, u));
