@@ -1243,33 +1243,13 @@ impl PartsReport {
 /// Connected pieces (through mesh edges) of the vertices labelled `r`, counting those with at
 /// least 10 % of the region's area.
 fn region_pieces(mesh: &crate::mesh::TriMesh, labels: &[i32], r: i32) -> usize {
-    let d = labels.len();
-    let mut parent: Vec<u32> = (0..d as u32).collect();
-    fn find(p: &mut [u32], mut x: u32) -> u32 {
-        while p[x as usize] != x {
-            p[x as usize] = p[p[x as usize] as usize];
-            x = p[x as usize];
-        }
-        x
-    }
-    for f in mesh.faces() {
-        for k in 0..3 {
-            let (a, b) = (f[k], f[(k + 1) % 3]);
-            if labels[a as usize] == r && labels[b as usize] == r {
-                let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
-                if ra != rb {
-                    parent[ra.max(rb) as usize] = ra.min(rb);
-                }
-            }
-        }
-    }
+    let comps = crate::mesh::labelled_components(mesh, labels);
     let areas = mesh.vertex_areas();
     let mut piece = std::collections::BTreeMap::<u32, f64>::new();
     let mut total = 0.0;
-    for v in 0..d {
+    for v in 0..labels.len() {
         if labels[v] == r {
-            let root = find(&mut parent, v as u32);
-            *piece.entry(root).or_default() += areas[v];
+            *piece.entry(comps.labels[v]).or_default() += areas[v];
             total += areas[v];
         }
     }

@@ -14,7 +14,9 @@
 //! - [`mirror_pairs`]: which tuples are left/right copies of each other (each shape's own
 //!   plane of mirror symmetry, [`mirror_plane`]); the part tree merges them first.
 //! - [`geometric_part_tree`]: a part tree over equal-area regions that merges touching regions
-//!   (and mirror pairs) of one thickness (`--parts N --parts-from geometry`).
+//!   (and mirror pairs) of one thickness (`--parts N --parts-from geometry`), after
+//!   [`split_disconnected_leaves`] has split regions made of pieces of different parts, and
+//!   before [`snap_part_boundaries`] moves the parts' boundaries onto creases.
 //! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
 //!   boundaries over every edge of the graph.
 //! - [`segment_collection`]: graph, co-segmentation and refinement in one call, as
@@ -32,6 +34,7 @@ mod refine_cosegmentation;
 mod segment_collection;
 mod shape_graph;
 mod snap_part_boundaries;
+mod split_disconnected_leaves;
 mod stable_cycle;
 
 pub use adaptive_cosegment::{
@@ -40,7 +43,9 @@ pub use adaptive_cosegment::{
 };
 pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
 pub use cycle_consistency::{CycleConsistency, cycle_consistency};
-pub use geometric_part_tree::{geometric_part_tree, geometric_part_tree_with_cues};
+pub use geometric_part_tree::{
+    SIBLING_COST, geometric_part_tree, geometric_part_tree_linked, geometric_part_tree_with_cues,
+};
 pub use load_collection::{
     LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
 };
@@ -58,6 +63,7 @@ pub use segment_collection::{
 };
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
 pub use snap_part_boundaries::snap_part_boundaries;
+pub use split_disconnected_leaves::{SPLIT_PIECE_SHARE, SplitLeaves, split_disconnected_leaves};
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
 };

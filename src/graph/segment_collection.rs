@@ -7,7 +7,8 @@ use super::snap_part_boundaries::check_band;
 use super::{
     AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
     Likeness, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment,
-    geometric_part_tree_with_cues, mirror_pairs, refine_cosegmentation_sized, snap_part_boundaries,
+    geometric_part_tree_linked, mirror_pairs, refine_cosegmentation_sized, snap_part_boundaries,
+    split_disconnected_leaves,
 };
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -93,9 +94,11 @@ pub enum PartsFrom {
     #[default]
     Adaptive,
     /// `leaves` equal-area regions ([`cosegment`], refined freely: `refine_sizes` does not
-    /// apply, equal areas carry no sizes to keep), grouped by
-    /// [`super::geometric_part_tree`]: touching regions (and mirror pairs) of one thickness
-    /// across convex boundaries merge first. Needs the meshes and a number of parts. After
+    /// apply, equal areas carry no sizes to keep), split into their kinds of pieces
+    /// ([`super::split_disconnected_leaves`]) and grouped by
+    /// [`super::geometric_part_tree_linked`]: touching regions (and mirror pairs, then
+    /// siblings) of one thickness across convex boundaries merge first. Needs the meshes and
+    /// a number of parts. After
     /// the cut, no refinement (it would drift the grouped parts back towards equal areas) but
     /// [`super::snap_part_boundaries`]: each boundary moves, within `band`, onto the cut of
     /// least weight, concave creases being cheap.
@@ -549,16 +552,20 @@ pub fn segment_collection(
             )?;
             times.refine += t.elapsed();
         }
-        // Parts from geometry: the refined equal-area regions are the leaves, cut after their
-        // refinement (a refinement of the grouped parts would drift them back to equal areas);
-        // then the parts' boundaries, still the leaves', move onto the creases between parts.
+        // Parts from geometry: the refined equal-area regions, split into their kinds of
+        // pieces, are the leaves, cut after their refinement (a refinement of the grouped
+        // parts would drift them back to equal areas); then the parts' boundaries, still the
+        // leaves', move onto the creases between parts.
         if let Some((_, parts, band)) = geometry {
             let t = Instant::now();
+            let split = split_disconnected_leaves(meshes, &segmentation)?;
+            let siblings = split.siblings();
+            segmentation = split.segmentation;
             let links = mirror_links(&graph, meshes, &segmentation, options);
             let cues = cues
                 .as_deref()
                 .expect("computed above with parts from geometry");
-            let tree = geometric_part_tree_with_cues(meshes, cues, &segmentation, &links)?;
+            let tree = geometric_part_tree_linked(meshes, cues, &segmentation, &links, &siblings)?;
             let a = AdaptiveCosegmentation {
                 leaves: segmentation,
                 auto: Vec::new(),

@@ -18,7 +18,10 @@ pub use io::{
     MeshFormat, PlyVertexProperty, read_mesh, read_mesh_from_bytes, read_mesh_with_report,
     write_atomic, write_mesh,
 };
-pub use topology::{Components, boundary_edges, connected_components, edge_adjacency, edges};
+pub(crate) use topology::for_each_label_boundary;
+pub use topology::{
+    Components, boundary_edges, connected_components, edge_adjacency, edges, labelled_components,
+};
 pub use validate::{MeshReport, MeshWarning};
 
 /// Errors raised while reading, writing or building a mesh. Every variant that concerns a file

@@ -82,6 +82,22 @@ pub struct Components {
 
 /// Connected components of the mesh (union–find over face edges).
 pub fn connected_components(mesh: &TriMesh) -> Components {
+    labelled_components(mesh, &vec![0; mesh.vertex_count()])
+}
+
+/// Connected components of each label's vertices: vertices joined by a triangle edge whose
+/// two ends carry the same label (#V labels, any values; negative ones are a label too).
+/// Numbered as [`connected_components`] numbers them.
+///
+/// ```
+/// use coseg::mesh::{labelled_components, TriMesh};
+/// // A strip of two triangles, labels 0, 1, 0, 0: vertex 1 is cut off from the others.
+/// let m = TriMesh::new(vec![[0.,0.,0.],[1.,0.,0.],[0.,1.,0.],[1.,1.,0.]],
+///     vec![[0, 1, 2], [1, 3, 2]]).unwrap();
+/// let c = labelled_components(&m, &[0, 1, 0, 0]);
+/// assert_eq!((c.labels, c.count), (vec![0, 1, 0, 0], 2));
+/// ```
+pub fn labelled_components(mesh: &TriMesh, labels: &[i32]) -> Components {
     let d = mesh.vertex_count();
     let mut parent: Vec<u32> = (0..d as u32).collect();
     fn find(parent: &mut [u32], mut x: u32) -> u32 {
@@ -92,8 +108,12 @@ pub fn connected_components(mesh: &TriMesh) -> Components {
         x
     }
     for f in mesh.faces() {
-        for k in 1..3 {
-            let (ra, rb) = (find(&mut parent, f[0]), find(&mut parent, f[k]));
+        for k in 0..3 {
+            let (a, b) = (f[k], f[(k + 1) % 3]);
+            if labels[a as usize] != labels[b as usize] {
+                continue;
+            }
+            let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
             if ra != rb {
                 // Keep the smaller index as root so numbering is deterministic.
                 let (lo, hi) = (ra.min(rb), ra.max(rb));
@@ -101,10 +121,10 @@ pub fn connected_components(mesh: &TriMesh) -> Components {
             }
         }
     }
-    let mut labels = vec![u32::MAX; d];
+    let mut out = vec![u32::MAX; d];
     let mut count = 0usize;
     let mut root_label = vec![u32::MAX; d];
-    for (v, label) in labels.iter_mut().enumerate() {
+    for (v, label) in out.iter_mut().enumerate() {
         let r = find(&mut parent, v as u32) as usize;
         if root_label[r] == u32::MAX {
             root_label[r] = count as u32;
@@ -112,5 +132,26 @@ pub fn connected_components(mesh: &TriMesh) -> Components {
         }
         *label = root_label[r];
     }
-    Components { labels, count }
+    Components { labels: out, count }
+}
+
+/// Calls `visit(u, v, length)` for every face side `(u, v)` whose ends carry two different
+/// labels, both non-negative (#V labels): each interior boundary edge twice, once from each
+/// of its faces, in face order.
+pub(crate) fn for_each_label_boundary(
+    mesh: &TriMesh,
+    labels: &[i32],
+    mut visit: impl FnMut(usize, usize, f64),
+) {
+    let p = mesh.positions();
+    for f in mesh.faces() {
+        for k in 0..3 {
+            let (u, v) = (f[k] as usize, f[(k + 1) % 3] as usize);
+            let (x, y) = (labels[u], labels[v]);
+            if x < 0 || y < 0 || x == y {
+                continue;
+            }
+            visit(u, v, super::norm(super::sub(p[u], p[v])));
+        }
+    }
 }
