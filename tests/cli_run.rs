@@ -258,9 +258,23 @@ fn parts_from_geometry_is_recorded_and_checked() {
         serde_json::json!({"kind": "geometry", "leaves": 5, "band": 0.1})
     );
     assert_eq!(summary["parts"]["stop"]["reason"], "equal_area_leaves");
-    // Five regions, and one more leaf per kind of piece a region is split into.
+    // Five regions, and one more leaf per kind of piece a region is split into, each
+    // recorded with the region it comes from.
     let leaves = summary["parts"]["leaf_areas"].as_array().unwrap().len();
     assert!(leaves >= 5, "{leaves}");
+    if leaves > 5 {
+        let origin: Vec<u64> = summary["parts"]["leaf_origin"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|x| x.as_u64().unwrap())
+            .collect();
+        assert_eq!(origin.len(), leaves);
+        assert_eq!(origin[..5], [0, 1, 2, 3, 4]);
+        assert!(origin[5..].iter().all(|&o| o < 5), "{origin:?}");
+    } else {
+        assert!(summary["parts"].get("leaf_origin").is_none());
+    }
     assert_eq!(
         summary["parts"]["region_leaves"].as_array().unwrap().len(),
         2

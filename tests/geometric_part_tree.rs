@@ -163,6 +163,9 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
     assert!(a.leaves.tuples.len() >= 6, "{}", a.leaves.tuples.len());
     assert_eq!(a.tree.leaves, a.leaves.tuples.len());
     assert_eq!(a.tree.merges.len(), a.leaves.tuples.len() - 1);
+    assert_eq!(a.leaf_origin.len(), a.leaves.tuples.len());
+    assert_eq!(a.leaf_origin[..6], [0, 1, 2, 3, 4, 5]);
+    assert!(a.leaf_origin[6..].iter().all(|&o| o < 6));
     assert_eq!(out.segmentation.tuples.len(), 2);
     // The parts are the tree's cut of the refined equal-area leaves, with no refinement after.
     assert_eq!(out.segmentation, a.cut(2));

@@ -164,8 +164,18 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
     if let (Some(a), Some(report)) = (&result.adaptive, result.parts_report(&loaded.meshes)) {
         if !super::quiet() {
             println!(
-                "parts: {} finest ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}; mirror pairs (left/right copies): {:?}",
+                "parts: {} finest{} ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}; mirror pairs (left/right copies): {:?}",
                 a.leaves.tuples.len(),
+                match report
+                    .leaf_origin
+                    .iter()
+                    .enumerate()
+                    .filter(|&(i, &o)| i != o)
+                    .count()
+                {
+                    0 => String::new(),
+                    n => format!(", {n} of them pieces split off their regions"),
+                },
                 a.stop,
                 seg.tuples.len(),
                 report.mirror_candidates,

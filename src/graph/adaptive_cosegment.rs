@@ -292,6 +292,11 @@ pub struct AdaptiveCosegmentation {
     pub stop: StopReason,
     /// The merge tree over `leaves.tuples`.
     pub tree: PartTree,
+    /// With parts from geometry: the equal-area region each leaf was split from
+    /// ([`super::split_disconnected_leaves`]; a region split into its pieces gives several
+    /// leaves, the first keeping its id). Empty otherwise (every leaf is its own).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub leaf_origin: Vec<usize>,
 }
 
 impl AdaptiveCosegmentation {
@@ -818,6 +823,7 @@ pub fn adaptive_cosegment(
         auto,
         stop,
         tree,
+        leaf_origin: Vec::new(),
     })
 }
 
@@ -1118,6 +1124,11 @@ pub struct PartsReport {
     pub auto: Vec<AutoTuple>,
     /// The merge tree over the leaves.
     pub tree: PartTree,
+    /// With parts from geometry: the equal-area region (of `--regions`) each leaf comes from,
+    /// when some region was split into its pieces ([`AdaptiveCosegmentation::leaf_origin`]);
+    /// omitted otherwise.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub leaf_origin: Vec<usize>,
     /// Per final region id: the leaves it is made of.
     pub region_leaves: Vec<Vec<usize>>,
     /// Per final region id: the median over shapes of its connected pieces holding at least
@@ -1232,6 +1243,16 @@ impl PartsReport {
                 .collect(),
             auto: adaptive.auto.clone(),
             tree: adaptive.tree.clone(),
+            leaf_origin: if adaptive
+                .leaf_origin
+                .iter()
+                .enumerate()
+                .all(|(i, &o)| i == o)
+            {
+                Vec::new()
+            } else {
+                adaptive.leaf_origin.clone()
+            },
             region_leaves,
             pieces,
             mirror_candidates,

@@ -560,6 +560,7 @@ pub fn segment_collection(
             let t = Instant::now();
             let split = split_disconnected_leaves(meshes, &segmentation)?;
             let siblings = split.siblings();
+            let leaf_origin = split.origin;
             segmentation = split.segmentation;
             let links = mirror_links(&graph, meshes, &segmentation, options);
             let cues = cues
@@ -571,6 +572,7 @@ pub fn segment_collection(
                 auto: Vec::new(),
                 stop: StopReason::EqualAreaLeaves,
                 tree,
+                leaf_origin,
             };
             segmentation = snap_part_boundaries(meshes, &a.cut(parts), band)?;
             adaptive = Some(a);
