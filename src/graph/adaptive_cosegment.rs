@@ -292,9 +292,10 @@ pub struct AdaptiveCosegmentation {
     pub stop: StopReason,
     /// The merge tree over `leaves.tuples`.
     pub tree: PartTree,
-    /// With parts from geometry: the equal-area region each leaf was split from
-    /// ([`super::split_disconnected_leaves`]; a region split into its pieces gives several
-    /// leaves, the first keeping its id). Empty otherwise (every leaf is its own).
+    /// With parts from geometry, when some region was split into its pieces
+    /// ([`super::split_disconnected_leaves`]): the equal-area region each leaf comes from (a
+    /// split region gives several leaves, the first keeping its id). Empty otherwise: every
+    /// leaf is its own.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub leaf_origin: Vec<usize>,
 }
@@ -1243,16 +1244,7 @@ impl PartsReport {
                 .collect(),
             auto: adaptive.auto.clone(),
             tree: adaptive.tree.clone(),
-            leaf_origin: if adaptive
-                .leaf_origin
-                .iter()
-                .enumerate()
-                .all(|(i, &o)| i == o)
-            {
-                Vec::new()
-            } else {
-                adaptive.leaf_origin.clone()
-            },
+            leaf_origin: adaptive.leaf_origin.clone(),
             region_leaves,
             pieces,
             mirror_candidates,

@@ -558,9 +558,15 @@ pub fn segment_collection(
         // leaves', move onto the creases between parts.
         if let Some((_, parts, band)) = geometry {
             let t = Instant::now();
+            let regions = segmentation.tuples.len();
             let split = split_disconnected_leaves(meshes, &segmentation)?;
             let siblings = split.siblings();
-            let leaf_origin = split.origin;
+            // Recorded only when a region was split: otherwise every leaf is its own.
+            let leaf_origin = if split.origin.len() > regions {
+                split.origin
+            } else {
+                Vec::new()
+            };
             segmentation = split.segmentation;
             let links = mirror_links(&graph, meshes, &segmentation, options);
             let cues = cues

@@ -167,8 +167,8 @@ pub fn split_disconnected_leaves(
         copy.leftover = false;
         tuples.push(copy);
     }
-    for (i, (mesh, s)) in meshes.iter().zip(&shapes).enumerate() {
-        let areas = mesh.vertex_areas();
+    for (i, s) in shapes.iter().enumerate() {
+        let areas = &s.areas;
         let total: f64 = areas.iter().sum();
         let mut regions: Vec<Vec<u32>> = vec![Vec::new(); tuples.len()];
         for (r, tuple) in coseg.tuples.iter().enumerate() {
@@ -238,8 +238,9 @@ impl SplitLeaves {
 const ISLAND: usize = usize::MAX;
 
 /// One shape's pieces: each vertex's piece, each piece's key, and per region the share of its
-/// area held by each key's pieces.
+/// area held by each key's pieces; the vertex areas they were measured with.
 struct ShapePieces {
+    areas: Vec<f64>,
     piece: Vec<u32>,
     piece_key: Vec<usize>,
     shares: Vec<BTreeMap<usize, f64>>,
@@ -282,6 +283,7 @@ impl ShapePieces {
             }
         }
         Self {
+            areas,
             piece,
             piece_key,
             shares,
