@@ -12,7 +12,9 @@
 //! (`coseg segment --parts-from`; with `geometry`, `@max=R` is the number of regions and
 //! `--snap-band W` the band of the boundary snapping, `coseg segment --snap-band`).
 //! `--detail` prints, for families, each shape's own purity / coverage, the pooled area table
-//! (region × grouped part, % of a shape) and the best any grouping of the regions could score.
+//! (region × grouped part, % of a shape) and the best any grouping of the regions could score;
+//! for the part modes the same for the leaves, the merge tree and, when regions were split into
+//! their pieces, each leaf's region of origin.
 //! `FOLDER` is either a COSEG-style set (`shapes/N.off` and `gt/N.seg`, one label per face) or a
 //! shipped family (`collections/<family>`, per-vertex labels and a manifest). Each `MODE` is
 //! `fixed:R` (`cosegment`, R equal-area regions, today's `coseg segment --regions R`), `auto`
@@ -380,6 +382,9 @@ fn main() -> Res<()> {
                     .map(|m| (m.a, m.b, (100.0 * m.similarity).round() / 100.0))
                     .collect::<Vec<_>>()
             );
+            if !a.leaf_origin.is_empty() {
+                eprintln!("  leaf origin: {:?}", a.leaf_origin);
+            }
             eprintln!("  final:");
         }
         let score = if coseg_set {

@@ -293,3 +293,52 @@ fn geometric_part_tree_with_cues_is_the_tree_and_refuses_cues_that_do_not_fit() 
     assert!(matches!(tree(&cues), Err(GraphError::BadOption(_))));
     assert!(matches!(tree(&cues[..2]), Err(GraphError::BadOption(_))));
 }
+
+/// Regression (`leaves never on one shape together`, session 22): complete linkage took the
+/// thickness distance of two leaves that are never present on one shape together as infinite,
+/// so any group holding both could never merge with anything at a finite cost (on generated
+/// chairs, the feet of every leg stayed a part of their own). Pairs that are never together
+/// now say nothing; the others decide.
+#[test]
+fn leaves_never_on_one_shape_together_do_not_block_a_merge() {
+    // Two strips of 10 columns; leaf 0 is the left half on both, the right half is leaf 1 on
+    // shape 0 and leaf 2 on shape 1: leaves 1 and 2 are never together.
+    let strip = || {
+        let mut p = Vec::new();
+        for c in 0..=10 {
+            p.push([c as f64, 0.0, 0.0]);
+            p.push([c as f64, 1.0, 0.0]);
+        }
+        let f = (0..10u32)
+            .flat_map(|c| {
+                [
+                    [2 * c, 2 * c + 2, 2 * c + 1],
+                    [2 * c + 1, 2 * c + 2, 2 * c + 3],
+                ]
+            })
+            .collect();
+        TriMesh::new(p, f).unwrap()
+    };
+    let meshes = vec![strip(), strip()];
+    let left: Vec<u32> = (0..10).collect();
+    let right: Vec<u32> = (10..22).collect();
+    let coseg = coseg_of(
+        &meshes,
+        &[
+            vec![left.clone(), right.clone(), vec![]],
+            vec![left, vec![], right],
+        ],
+    );
+    let cues: Vec<PartCues> = meshes
+        .iter()
+        .map(|m| PartCues {
+            thickness: vec![1.0; m.vertex_count()],
+            mean_curvature: vec![1.0; m.vertex_count()],
+        })
+        .collect();
+    let tree = geometric_part_tree_with_cues(&meshes, &cues, &coseg, &[]).unwrap();
+    // Uniform thickness, convex boundaries: every merge costs 0. Before the fix the second
+    // merge ({0, 1} with 2, which touch through 0) cost infinity (similarity 0).
+    assert_eq!(tree.merges.len(), 2);
+    assert!(tree.merges.iter().all(|m| m.similarity == 1.0), "{tree:?}");
+}

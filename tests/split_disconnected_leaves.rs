@@ -5,8 +5,8 @@ mod common;
 
 use common::graph::coseg_of;
 use coseg::graph::{
-    Cosegmentation, GraphError, PartCues, SPLIT_PIECE_SHARE, geometric_part_tree_linked,
-    geometric_part_tree_with_cues, split_disconnected_leaves,
+    Cosegmentation, GraphError, PartCues, SPLIT_PIECE_SHARE, SPLIT_SAME_DIRECTION,
+    geometric_part_tree_linked, geometric_part_tree_with_cues, split_disconnected_leaves,
 };
 use coseg::mesh::TriMesh;
 
@@ -24,6 +24,25 @@ fn strip() -> TriMesh {
         f.push([a + 1, a + 2, a + 3]);
     }
     TriMesh::new(p, f).unwrap()
+}
+
+/// [`strip`] with its last two columns (x = 9, 10) folded up about the line x = 8 by
+/// `degrees`: their faces' normals turn by that angle, the rest stays in the plane z = 0.
+fn folded_strip(degrees: f64) -> TriMesh {
+    let (sin, cos) = degrees.to_radians().sin_cos();
+    let m = strip();
+    let p: Vec<[f64; 3]> = m
+        .positions()
+        .iter()
+        .map(|&[x, y, _]| {
+            if x > 8.0 {
+                [8.0 + (x - 8.0) * cos, y, (x - 8.0) * sin]
+            } else {
+                [x, y, 0.0]
+            }
+        })
+        .collect();
+    TriMesh::new(p, m.faces().to_vec()).unwrap()
 }
 
 /// The vertices of columns `cols` (x values).
@@ -66,6 +85,8 @@ fn pieces_bordering_different_regions_become_two_tuples() {
     assert_eq!(s.tuples.len(), 4);
     assert_eq!(split.origin, vec![0, 1, 2, 0]);
     assert_eq!(split.siblings(), vec![(0, 3)]);
+    // A flat strip: both pieces face the same way.
+    assert_eq!(split.alike, vec![(0, 3)]);
     let total = meshes[0].total_area();
     for (i, mesh) in meshes.iter().enumerate() {
         // Equal pieces: the kind with the lower key (region 1) keeps the id.
@@ -207,4 +228,39 @@ fn siblings_merge_after_touching_leaves_of_the_same_cost() {
     assert_eq!((tree.merges[1].a, tree.merges[1].b), (3, 4));
     let expected = (-coseg::graph::SIBLING_COST).exp();
     assert!((tree.merges[1].similarity - expected).abs() < 1e-12);
+}
+
+#[test]
+fn siblings_are_alike_when_their_pieces_face_the_same_way() {
+    // The right piece (columns 9, 10) is folded up: its mean normal turns by exactly the fold
+    // angle against the left piece's (columns 0, 1; column 9's faces are both folded).
+    for (degrees, alike) in [
+        (0.0, true),
+        (SPLIT_SAME_DIRECTION - 5.0, true),
+        (SPLIT_SAME_DIRECTION + 5.0, false),
+        (90.0, false),
+    ] {
+        let meshes = vec![folded_strip(degrees); 3];
+        let coseg = coseg_of(&meshes, &vec![two_kinds(); 3]);
+        let split = split_disconnected_leaves(&meshes, &coseg).unwrap();
+        // The split itself does not depend on the fold.
+        assert_eq!(split.origin, vec![0, 1, 2, 0], "{degrees}°");
+        let expected = if alike { vec![(0, 3)] } else { vec![] };
+        assert_eq!(split.alike, expected, "{degrees}°");
+    }
+    // The median over shapes decides: folded on two of three shapes, not alike.
+    let meshes = vec![folded_strip(90.0), folded_strip(0.0), folded_strip(90.0)];
+    let coseg = coseg_of(&meshes, &vec![two_kinds(); 3]);
+    assert!(
+        split_disconnected_leaves(&meshes, &coseg)
+            .unwrap()
+            .alike
+            .is_empty()
+    );
+    let meshes = vec![folded_strip(0.0), folded_strip(90.0), folded_strip(0.0)];
+    let coseg = coseg_of(&meshes, &vec![two_kinds(); 3]);
+    assert_eq!(
+        split_disconnected_leaves(&meshes, &coseg).unwrap().alike,
+        vec![(0, 3)]
+    );
 }

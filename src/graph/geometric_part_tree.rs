@@ -15,7 +15,9 @@
 //!
 //! `cost(a, b) = max_{x ∈ a, y ∈ b} d(x, y) + mean_{x ∈ a, y ∈ b touching} c(x, y)`,
 //!
-//! both terms dimensionless: `d(x, y)` = the (upper) median over shapes of `|ln t_x − ln t_y|`,
+//! both terms dimensionless (the maximum over the pairs present together on some shape: a
+//! pair never on one shape says nothing): `d(x, y)` = the (upper) median over the shapes
+//! holding both of `|ln t_x − ln t_y|`,
 //! `t` a region's thickness on a shape (the area-weighted geometric mean of the raw shape
 //! diameter function, [`crate::features::shape_diameter`] with one smoothing round,
 //! scale-normalised per shape); `c(x, y)` = the (upper) median over shapes of the concave
@@ -150,7 +152,10 @@ pub fn geometric_part_tree_with_cues(
 /// ones of about the same cost. Chosen among 0, 0.15, 0.2, 0.3 and 0.6 by the sets meeting
 /// the bar on seeds 1–9 of the generated families (docs/PARTS.md, "Regions split into their
 /// pieces"): 0 merges hands with thighs again; from 0.2 on, the shipped chairs' front and
-/// back legs stay apart (a known issue).
+/// back legs stayed apart. Since then siblings whose pieces face the same way
+/// ([`super::SplitLeaves::alike`]: copies side by side, such as those legs' feet) are passed
+/// as links instead, as `coseg segment` does, and merge without it (docs/PARTS.md, "Copies
+/// and look-alikes").
 pub const SIBLING_COST: f64 = 0.3;
 
 /// [`geometric_part_tree_with_cues`] with sibling pairs of leaves (`siblings`, e.g.
@@ -269,7 +274,13 @@ fn merge_order(
     let mut merges = Vec::with_capacity(l.saturating_sub(1));
     let cost = |ma: &[usize], mb: &[usize]| -> f64 {
         let pairs = || ma.iter().flat_map(|&x| mb.iter().map(move |&y| (x, y)));
-        let thickness = pairs().map(|(x, y)| distance[x][y]).fold(0.0, f64::max);
+        // Leaves never present on one shape together say nothing about each other's
+        // thickness; only when no pair is ever together is the distance unknown (infinite).
+        let thickness = pairs()
+            .map(|(x, y)| distance[x][y])
+            .filter(|d| d.is_finite())
+            .fold(None, |m: Option<f64>, d| Some(m.map_or(d, |m| m.max(d))))
+            .unwrap_or(f64::INFINITY);
         let shares: Vec<f64> = pairs()
             .map(|(x, y)| concave[x][y])
             .filter(|c| c.is_finite())

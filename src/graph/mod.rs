@@ -63,7 +63,9 @@ pub use segment_collection::{
 };
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
 pub use snap_part_boundaries::snap_part_boundaries;
-pub use split_disconnected_leaves::{SPLIT_PIECE_SHARE, SplitLeaves, split_disconnected_leaves};
+pub use split_disconnected_leaves::{
+    SPLIT_PIECE_SHARE, SPLIT_SAME_DIRECTION, SplitLeaves, split_disconnected_leaves,
+};
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
 };

@@ -96,8 +96,9 @@ pub enum PartsFrom {
     /// `leaves` equal-area regions ([`cosegment`], refined freely: `refine_sizes` does not
     /// apply, equal areas carry no sizes to keep), split into their kinds of pieces
     /// ([`super::split_disconnected_leaves`]) and grouped by
-    /// [`super::geometric_part_tree_linked`]: touching regions (and mirror pairs, then
-    /// siblings) of one thickness across convex boundaries merge first. Needs the meshes and
+    /// [`super::geometric_part_tree_linked`]: touching regions (and mirror pairs and siblings
+    /// facing the same way, then the other siblings) of one thickness across convex
+    /// boundaries merge first. Needs the meshes and
     /// a number of parts. After
     /// the cut, no refinement (it would drift the grouped parts back towards equal areas) but
     /// [`super::snap_part_boundaries`]: each boundary moves, within `band`, onto the cut of
@@ -568,7 +569,10 @@ pub fn segment_collection(
                 Vec::new()
             };
             segmentation = split.segmentation;
-            let links = mirror_links(&graph, meshes, &segmentation, options);
+            // Siblings facing the same way are copies of one part (a chair's front and back
+            // legs): linked like mirror pairs, at no extra cost.
+            let mut links = mirror_links(&graph, meshes, &segmentation, options);
+            links.extend(split.alike);
             let cues = cues
                 .as_deref()
                 .expect("computed above with parts from geometry");

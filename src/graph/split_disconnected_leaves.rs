@@ -15,18 +15,31 @@
 //!
 //! The tuples split from one region are **siblings**: the features found them alike, and
 //! sometimes rightly so (a chair's front and back legs, which touch nothing in common but
-//! the seat). [`super::geometric_part_tree_linked`] may therefore merge siblings that do not
-//! touch, at an extra cost ([`super::SIBLING_COST`]), so that alike pieces of different parts
-//! (a hand resting on a thigh) stay apart unless nothing cheaper is left.
+//! the seat). Which case it is shows in the direction the pieces face: copies of one part side
+//! by side face the same way (a chair's four feet all face down), different parts in like
+//! places do not (a leg's tip faces down, the tail's tip backwards). Siblings whose pieces'
+//! mean normals agree ([`SplitLeaves::alike`]) are linked in the part tree like mirror pairs;
+//! the others may merge without touching only at an extra cost
+//! ([`super::SIBLING_COST`]), so that alike pieces of different parts (a hand resting on a
+//! thigh) stay apart unless nothing cheaper is left.
 
 use super::{Cosegmentation, GraphError};
-use crate::mesh::{TriMesh, for_each_label_boundary, labelled_components};
+use crate::mesh::{TriMesh, dot, for_each_label_boundary, labelled_components, norm};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// The least share of its region's area (on one shape) a piece kind must hold to count,
 /// in `(0, 1)`: below it a piece is a fragment of the refinement, not a part.
 pub const SPLIT_PIECE_SHARE: f64 = 0.15;
+
+/// Two kinds split from one region are *alike* ([`SplitLeaves::alike`]) when the (upper)
+/// median over the shapes where both have pieces of the angle between their pieces'
+/// area-weighted mean normals is below this (degrees). Copies of one part side by side face the same way (a chair's
+/// front and back feet: 14–24° on the generated chairs), different parts in like places do
+/// not (a leg's tip and the tail's tip, a hand and a foot: 46° and more on the generated
+/// quadrupeds and humanoids); 35° is the middle of that gap, and every level from 30° to 60°
+/// gives the same sets meeting the bar (docs/PARTS.md, "Copies and look-alikes").
+pub const SPLIT_SAME_DIRECTION: f64 = 35.0;
 
 /// `coseg`'s tuples with each disconnected tuple split by the kind of its pieces (module
 /// docs).
@@ -47,7 +60,8 @@ pub const SPLIT_PIECE_SHARE: f64 = 0.15;
 /// are appended in order of tuple then key. A new tuple copies its tuple's statistics
 /// (confidence, sweeps, …; never `leftover`) and has its own area fractions; it may be empty
 /// on a shape where its kind of piece is missing. Tuples that do not split are returned as
-/// they are, bit for bit.
+/// they are, bit for bit. Which siblings face the same way ([`SplitLeaves::alike`]) is
+/// measured with the meshes' vertex normals.
 ///
 /// Errors: [`GraphError::BadOption`] when the meshes do not match `coseg`.
 ///
@@ -81,6 +95,8 @@ pub const SPLIT_PIECE_SHARE: f64 = 0.15;
 /// assert_eq!(split.segmentation.tuples[0].regions[0], vec![0, 1]);
 /// assert_eq!(split.segmentation.tuples[3].regions[0], vec![6, 7]);
 /// assert_eq!(split.siblings(), vec![(0, 3)]);
+/// // The strip is flat: both ends face the same way, so they are copies, not look-alikes.
+/// assert_eq!(split.alike, vec![(0, 3)]);
 /// ```
 pub fn split_disconnected_leaves(
     meshes: &[TriMesh],
@@ -153,12 +169,26 @@ pub fn split_disconnected_leaves(
             new_ids.insert((r, j), id);
         }
     }
+    let leaf = |r: usize, j: usize| if j == 0 { r } else { new_ids[&(r, j)] };
+    let mut alike = Vec::new();
+    for (r, keys) in kinds.iter().enumerate() {
+        for a in 0..keys.len() {
+            for b in a + 1..keys.len() {
+                if face_alike(&shapes, r, keys[a], keys[b]) {
+                    let (x, y) = (leaf(r, a), leaf(r, b));
+                    alike.push((x.min(y), x.max(y)));
+                }
+            }
+        }
+    }
+    alike.sort_unstable();
     let mut origin: Vec<usize> = (0..t).collect();
     origin.extend(new_ids.keys().map(|&(r, _)| r));
     if new_ids.is_empty() {
         return Ok(SplitLeaves {
             segmentation: coseg.clone(),
             origin,
+            alike,
         });
     }
     let mut tuples = coseg.tuples.clone();
@@ -199,7 +229,32 @@ pub fn split_disconnected_leaves(
             ..coseg.clone()
         },
         origin,
+        alike,
     })
+}
+
+/// Whether the pieces of keys `a` and `b` of region `r` face the same way: the upper median,
+/// over the shapes where both have pieces with a mean normal, of the angle between their
+/// mean normals is below [`SPLIT_SAME_DIRECTION`].
+fn face_alike(shapes: &[ShapePieces], r: usize, a: usize, b: usize) -> bool {
+    let mut angles: Vec<f64> = shapes
+        .iter()
+        .filter_map(|s| {
+            let (u, v) = (s.direction[r].get(&a)?, s.direction[r].get(&b)?);
+            let (nu, nv) = (norm(*u), norm(*v));
+            (nu > 0.0 && nv > 0.0).then(|| {
+                (dot(*u, *v) / (nu * nv))
+                    .clamp(-1.0, 1.0)
+                    .acos()
+                    .to_degrees()
+            })
+        })
+        .collect();
+    if angles.is_empty() {
+        return false;
+    }
+    angles.sort_by(f64::total_cmp);
+    angles[angles.len() / 2] < SPLIT_SAME_DIRECTION
 }
 
 /// What [`split_disconnected_leaves`] returns.
@@ -209,6 +264,11 @@ pub struct SplitLeaves {
     pub segmentation: Cosegmentation,
     /// For each of them, the input tuple it comes from (`origin[t] = t` for the first #T).
     pub origin: Vec<usize>,
+    /// The sibling pairs `(a, b)`, `a < b`, in order, whose pieces face the same way
+    /// ([`SPLIT_SAME_DIRECTION`]): copies of one part side by side (a chair's front and back
+    /// feet), which the part tree links like mirror pairs; the other siblings are look-alikes
+    /// of different parts until shown otherwise.
+    pub alike: Vec<(usize, usize)>,
 }
 
 impl SplitLeaves {
@@ -218,7 +278,7 @@ impl SplitLeaves {
     /// use coseg::graph::{Cosegmentation, SplitLeaves};
     /// let segmentation = Cosegmentation { names: vec![], vertices: vec![], root: 0,
     ///     order: vec![], parent: vec![], alpha: 0.0, tuples: vec![] };
-    /// let s = SplitLeaves { segmentation, origin: vec![0, 1, 2, 0, 0, 2] };
+    /// let s = SplitLeaves { segmentation, origin: vec![0, 1, 2, 0, 0, 2], alike: vec![] };
     /// assert_eq!(s.siblings(), vec![(0, 3), (0, 4), (2, 5), (3, 4)]);
     /// ```
     pub fn siblings(&self) -> Vec<(usize, usize)> {
@@ -244,6 +304,9 @@ struct ShapePieces {
     piece: Vec<u32>,
     piece_key: Vec<usize>,
     shares: Vec<BTreeMap<usize, f64>>,
+    /// direction[region][key]: the area-weighted sum of the vertex normals of the region's
+    /// pieces of that key (its direction is their mean normal).
+    direction: Vec<BTreeMap<usize, [f64; 3]>>,
 }
 
 impl ShapePieces {
@@ -267,15 +330,20 @@ impl ShapePieces {
         }
         let areas = mesh.vertex_areas();
         let mut region_area = vec![0.0; regions];
+        let normals = mesh.vertex_normals();
         let mut shares = vec![BTreeMap::<usize, f64>::new(); regions];
+        let mut direction = vec![BTreeMap::<usize, [f64; 3]>::new(); regions];
         for (v, &x) in labels.iter().enumerate() {
             if x < 0 {
                 continue;
             }
+            let key = piece_key[piece[v] as usize];
             region_area[x as usize] += areas[v];
-            *shares[x as usize]
-                .entry(piece_key[piece[v] as usize])
-                .or_default() += areas[v];
+            *shares[x as usize].entry(key).or_default() += areas[v];
+            let d = direction[x as usize].entry(key).or_insert([0.0; 3]);
+            for (d, n) in d.iter_mut().zip(normals[v]) {
+                *d += areas[v] * n;
+            }
         }
         for (share, &a) in shares.iter_mut().zip(&region_area) {
             for s in share.values_mut() {
@@ -287,6 +355,7 @@ impl ShapePieces {
             piece,
             piece_key,
             shares,
+            direction,
         }
     }
 }
