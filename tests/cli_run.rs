@@ -272,8 +272,16 @@ fn parts_from_geometry_is_recorded_and_checked() {
         assert_eq!(origin.len(), leaves);
         assert_eq!(origin[..5], [0, 1, 2, 3, 4]);
         assert!(origin[5..].iter().all(|&o| o < 5), "{origin:?}");
+        // Copies are pairs of leaves split from one region.
+        if let Some(copies) = summary["parts"].get("leaf_copies") {
+            for pair in copies.as_array().unwrap() {
+                let (a, b) = (pair[0].as_u64().unwrap(), pair[1].as_u64().unwrap());
+                assert!(a < b && origin[a as usize] == origin[b as usize], "{pair}");
+            }
+        }
     } else {
         assert!(summary["parts"].get("leaf_origin").is_none());
+        assert!(summary["parts"].get("leaf_copies").is_none());
     }
     assert_eq!(
         summary["parts"]["region_leaves"].as_array().unwrap().len(),

@@ -107,6 +107,17 @@ fn chairs_parts_from_geometry_meet_the_bar() {
         purity >= 0.88 && coverage >= 0.76,
         "{purity:.3} / {coverage:.3}"
     );
+    // The summary names the copies: pairs of leaves split from one region (the feet).
+    let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("e2e_parts_chairs");
+    let summary: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let origin = summary["parts"]["leaf_origin"].as_array().unwrap();
+    let copies = summary["parts"]["leaf_copies"].as_array().unwrap();
+    assert!(!copies.is_empty());
+    for pair in copies {
+        let (a, b) = (pair[0].as_u64().unwrap(), pair[1].as_u64().unwrap());
+        assert!(a < b && origin[a as usize] == origin[b as usize], "{pair}");
+    }
 }
 
 #[test]

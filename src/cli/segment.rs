@@ -174,7 +174,13 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
                     .count()
                 {
                     0 => String::new(),
-                    n => format!(", {n} of them pieces split off their regions"),
+                    n => format!(
+                        ", {n} of them pieces split off their regions{}",
+                        match report.leaf_copies.len() {
+                            0 => String::new(),
+                            c => format!(", {c} pairs of those copies of one part"),
+                        }
+                    ),
                 },
                 a.stop,
                 seg.tuples.len(),

@@ -298,6 +298,12 @@ pub struct AdaptiveCosegmentation {
     /// leaf is its own.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub leaf_origin: Vec<usize>,
+    /// Of those leaves, the pairs split from one region whose pieces face the same way
+    /// ([`super::SplitLeaves::alike`]: copies of one part, linked in the tree like mirror
+    /// pairs); `(a, b)` with `a < b`, in order. Empty when nothing was split or none face
+    /// alike.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub leaf_copies: Vec<(usize, usize)>,
 }
 
 impl AdaptiveCosegmentation {
@@ -825,6 +831,7 @@ pub fn adaptive_cosegment(
         stop,
         tree,
         leaf_origin: Vec::new(),
+        leaf_copies: Vec::new(),
     })
 }
 
@@ -1130,6 +1137,10 @@ pub struct PartsReport {
     /// omitted otherwise.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub leaf_origin: Vec<usize>,
+    /// The pairs of those leaves that are copies of one part facing the same way
+    /// ([`AdaptiveCosegmentation::leaf_copies`]); omitted when none.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub leaf_copies: Vec<(usize, usize)>,
     /// Per final region id: the leaves it is made of.
     pub region_leaves: Vec<Vec<usize>>,
     /// Per final region id: the median over shapes of its connected pieces holding at least
@@ -1245,6 +1256,7 @@ impl PartsReport {
             auto: adaptive.auto.clone(),
             tree: adaptive.tree.clone(),
             leaf_origin: adaptive.leaf_origin.clone(),
+            leaf_copies: adaptive.leaf_copies.clone(),
             region_leaves,
             pieces,
             mirror_candidates,

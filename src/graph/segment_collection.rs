@@ -572,7 +572,7 @@ pub fn segment_collection(
             // Siblings facing the same way are copies of one part (a chair's front and back
             // legs): linked like mirror pairs, at no extra cost.
             let mut links = mirror_links(&graph, meshes, &segmentation, options);
-            links.extend(split.alike);
+            links.extend_from_slice(&split.alike);
             let cues = cues
                 .as_deref()
                 .expect("computed above with parts from geometry");
@@ -583,6 +583,7 @@ pub fn segment_collection(
                 stop: StopReason::EqualAreaLeaves,
                 tree,
                 leaf_origin,
+                leaf_copies: split.alike,
             };
             segmentation = snap_part_boundaries(meshes, &a.cut(parts), band)?;
             adaptive = Some(a);
