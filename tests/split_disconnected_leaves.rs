@@ -248,6 +248,19 @@ fn siblings_are_alike_when_their_pieces_face_the_same_way() {
         let expected = if alike { vec![(0, 3)] } else { vec![] };
         assert_eq!(split.alike, expected, "{degrees}°");
     }
+    // Both normals turn over with the winding: the same answer on inside-out meshes.
+    for (degrees, expected) in [(0.0, vec![(0, 3)]), (90.0, vec![])] {
+        let m = folded_strip(degrees);
+        let flipped = TriMesh::new(
+            m.positions().to_vec(),
+            m.faces().iter().map(|&[a, b, c]| [a, c, b]).collect(),
+        )
+        .unwrap();
+        let meshes = vec![flipped; 3];
+        let coseg = coseg_of(&meshes, &vec![two_kinds(); 3]);
+        let split = split_disconnected_leaves(&meshes, &coseg).unwrap();
+        assert_eq!(split.alike, expected, "{degrees}° inside out");
+    }
     // The median over shapes decides: folded on two of three shapes, not alike.
     let meshes = vec![folded_strip(90.0), folded_strip(0.0), folded_strip(90.0)];
     let coseg = coseg_of(&meshes, &vec![two_kinds(); 3]);
