@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::graph::coseg_of;
+use common::graph::{coseg_of, uniform_cues};
 use coseg::bands::equal_count_bands;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{
@@ -329,13 +329,7 @@ fn leaves_never_on_one_shape_together_do_not_block_a_merge() {
             vec![left, vec![], right],
         ],
     );
-    let cues: Vec<PartCues> = meshes
-        .iter()
-        .map(|m| PartCues {
-            thickness: vec![1.0; m.vertex_count()],
-            mean_curvature: vec![1.0; m.vertex_count()],
-        })
-        .collect();
+    let cues = uniform_cues(&meshes);
     let tree = geometric_part_tree_with_cues(&meshes, &cues, &coseg, &[]).unwrap();
     // Uniform thickness, convex boundaries: every merge costs 0. Before the fix the second
     // merge ({0, 1} with 2, which touch through 0) cost infinity (similarity 0).

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::graph::coseg_of;
+use common::graph::{coseg_of, uniform_cues};
 use coseg::graph::{
     Cosegmentation, GraphError, PartCues, SPLIT_PIECE_SHARE, SPLIT_SAME_DIRECTION,
     geometric_part_tree_linked, geometric_part_tree_with_cues, split_disconnected_leaves,
@@ -191,13 +191,7 @@ fn siblings_merge_after_touching_leaves_of_the_same_cost() {
     let meshes = vec![strip(); 2];
     let coseg = coseg_of(&meshes, &vec![two_kinds(); 2]);
     let split = split_disconnected_leaves(&meshes, &coseg).unwrap();
-    let cues: Vec<PartCues> = meshes
-        .iter()
-        .map(|m| PartCues {
-            thickness: vec![1.0; m.vertex_count()],
-            mean_curvature: vec![1.0; m.vertex_count()],
-        })
-        .collect();
+    let cues = uniform_cues(&meshes);
     let plain = geometric_part_tree_with_cues(&meshes, &cues, &split.segmentation, &[]).unwrap();
     let none = geometric_part_tree_linked(&meshes, &cues, &split.segmentation, &[], &[]).unwrap();
     assert_eq!(plain, none);

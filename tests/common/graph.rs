@@ -1,7 +1,7 @@
 //! Fixtures for the shape-graph tests: structured band tables and vertex permutations.
 
 use coseg::bands::{BandTable, equal_count_bands};
-use coseg::graph::{Cosegmentation, RegionTuple};
+use coseg::graph::{Cosegmentation, PartCues, RegionTuple};
 use coseg::mesh::TriMesh;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
@@ -100,4 +100,16 @@ pub fn coseg_of(meshes: &[TriMesh], parts: &[Vec<Vec<u32>>]) -> Cosegmentation {
         alpha: 0.1,
         tuples,
     }
+}
+
+/// Part cues that make every geometric merge cost 0: thickness 1 and mean curvature 1 (convex)
+/// at every vertex of each mesh.
+pub fn uniform_cues(meshes: &[TriMesh]) -> Vec<PartCues> {
+    meshes
+        .iter()
+        .map(|m| PartCues {
+            thickness: vec![1.0; m.vertex_count()],
+            mean_curvature: vec![1.0; m.vertex_count()],
+        })
+        .collect()
 }
