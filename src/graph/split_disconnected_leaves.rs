@@ -33,12 +33,13 @@ use std::collections::BTreeMap;
 pub const SPLIT_PIECE_SHARE: f64 = 0.15;
 
 /// Two kinds split from one region are *alike* ([`SplitLeaves::alike`]) when the (upper)
-/// median over the shapes where both have pieces of the angle between their pieces'
-/// area-weighted mean normals is below this (degrees). Copies of one part side by side face the same way (a chair's
-/// front and back feet: 14–24° on the generated chairs), different parts in like places do
-/// not (a leg's tip and the tail's tip, a hand and a foot: 46° and more on the generated
-/// quadrupeds and humanoids); 35° is the middle of that gap, and every level from 30° to 60°
-/// gives the same sets meeting the bar (docs/PARTS.md, "Copies and look-alikes").
+/// median, over the shapes where both have pieces, of the angle between their pieces'
+/// area-weighted mean normals is below this (degrees). Copies of one part side by side face
+/// the same way (a chair's front and back feet: 14–24° on the generated chairs), different
+/// parts in like places do not (a leg's tip and the tail's tip, a hand and a foot: 46° and
+/// more on the generated quadrupeds and humanoids); 35° is the middle of that gap, and every
+/// level tried from 30° to 60° gives the same sets meeting the bar (docs/PARTS.md, "Copies
+/// and look-alikes").
 pub const SPLIT_SAME_DIRECTION: f64 = 35.0;
 
 /// `coseg`'s tuples with each disconnected tuple split by the kind of its pieces (module
