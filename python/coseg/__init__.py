@@ -467,7 +467,9 @@ def segment(
     area before refinement (meant for ``parts``); ``parts_from`` (``"adaptive"``): with
     ``parts=N``, ``"geometry"`` takes ``regions`` (default 12) equal-area regions and groups
     touching ones (and left/right copies) of one thickness across convex boundaries (``--parts-from geometry``,
-    docs/PARTS.md), then moves each part boundary onto a concave crease within ``snap_band``
+    docs/PARTS.md; a region made of separate pieces of different parts is split first, and
+    pieces split from one region that face the same way are grouped as copies of one part:
+    ``summary["parts"]["leaf_origin"]``, ``["leaf_copies"]``), then moves each part boundary onto a concave crease within ``snap_band``
     (None: 0.1) × √(shape area) (``--snap-band``; 0 keeps the regions' boundaries); ``area_fraction`` (None: 1 / regions) of
     each region; ``seed`` (None: start from the most distinctive vertex); ``complete_limit``
     (12): collections up to this size use a complete shape graph, larger ones ``neighbours``
