@@ -239,20 +239,20 @@ pub fn geometric_part_tree_linked(
                 .collect()
         })
         .collect();
+    // Marks each pair (both ways) in an #leaves by #leaves relation; pairs out of range are
+    // ignored.
+    let mark = |m: &mut Vec<Vec<bool>>, pairs: &[(usize, usize)]| {
+        for &(a, b) in pairs {
+            if a < l && b < l {
+                m[a][b] = true;
+                m[b][a] = true;
+            }
+        }
+    };
     let (mut linked, concave) = boundaries(meshes, cues, coseg);
-    for &(a, b) in links {
-        if a < l && b < l {
-            linked[a][b] = true;
-            linked[b][a] = true;
-        }
-    }
+    mark(&mut linked, links);
     let mut sibling = vec![vec![false; l]; l];
-    for &(a, b) in siblings {
-        if a < l && b < l {
-            sibling[a][b] = true;
-            sibling[b][a] = true;
-        }
-    }
+    mark(&mut sibling, siblings);
     Ok(PartTree {
         leaves: l,
         merges: merge_order(&distance, &linked, &sibling, &concave),

@@ -170,14 +170,14 @@ pub fn split_disconnected_leaves(
             new_ids.insert((r, j), id);
         }
     }
+    // The tuple of region r's kind j; ids grow with j, so a pair a < b stays in order.
     let leaf = |r: usize, j: usize| if j == 0 { r } else { new_ids[&(r, j)] };
     let mut alike = Vec::new();
     for (r, keys) in kinds.iter().enumerate() {
         for a in 0..keys.len() {
             for b in a + 1..keys.len() {
                 if face_alike(&shapes, r, keys[a], keys[b]) {
-                    let (x, y) = (leaf(r, a), leaf(r, b));
-                    alike.push((x.min(y), x.max(y)));
+                    alike.push((leaf(r, a), leaf(r, b)));
                 }
             }
         }
@@ -205,10 +205,10 @@ pub fn split_disconnected_leaves(
         for (r, tuple) in coseg.tuples.iter().enumerate() {
             for &v in &tuple.regions[i] {
                 let key = s.piece_key[s.piece[v as usize] as usize];
-                let id = match kinds[r].iter().position(|&k| k == key) {
-                    Some(j) if j > 0 => new_ids[&(r, j)],
-                    _ => r,
-                };
+                let id = kinds[r]
+                    .iter()
+                    .position(|&k| k == key)
+                    .map_or(r, |j| leaf(r, j));
                 regions[id].push(v);
             }
         }
