@@ -10,6 +10,7 @@
 //! | stage | module | what it produces |
 //! |---|---|---|
 //! | meshes | [`mesh`] | validated triangle meshes, readers and writers (OBJ, OFF, PLY) |
+//! | alignment | [`align`] | similarity transforms between shapes (pairwise registration), nearest-surface-point labels |
 //! | spectrum | [`spectral`] | cotangent Laplacian, lumped mass, Laplace–Beltrami eigenpairs |
 //! | features | [`features`] | per-vertex feature families: spectral (HKS, WKS, multiscale mean curvature), extrinsic heights, shape diameter, user columns |
 //! | bands | [`bands`] | per-feature rank bands stored as a compact `u8` table |
@@ -28,6 +29,7 @@
 #![deny(missing_docs)]
 
 pub mod affinity;
+pub mod align;
 pub mod bands;
 pub mod cache;
 pub mod evaluate;

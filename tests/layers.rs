@@ -1,5 +1,5 @@
 //! The pipeline's stages depend one way: no module of the library names (outside comments) a
-//! module of a later stage. The order is the README's: mesh → per-shape operators and spectrum →
+//! module of a later stage. The order is the README's: mesh → align → per-shape operators and spectrum →
 //! features → bands → per-shape pipeline → affinity → maps → stable → graph → propagate →
 //! evaluate → output. Doc links may point forward; code may not.
 
@@ -13,6 +13,7 @@ const ORDER: &[&str] = &[
     "labels",
     "generate",
     "cache",
+    "align",
     "spectral",
     "features",
     "bands",

@@ -1,0 +1,48 @@
+//! Alignment: similarity transforms (rotation, uniform scale, translation) that put shapes in
+//! one frame, and labels carried by nearest surface points (docs/ALIGN.md).
+//!
+//! Pairwise (the rigid route of label transfer and the evaluation baseline):
+//! - [`Similarity`]: `x ↦ s R x + t`; [`Similarity::apply`], [`Similarity::compose`],
+//!   [`Similarity::inverse`], [`Similarity::rotation_angle_to`];
+//! - [`register_pair`]`(source, target, &`[`RegisterOptions`]`) -> Result<`[`Registration`]`, `[`AlignError`]`>`:
+//!   the similarity taking `target` onto `source`, its residual (symmetric trimmed chamfer in
+//!   source RMS radii), inlier share, and the runner-up pose of a symmetric shape;
+//! - [`closest_surface_points`]`(mesh, points) -> Vec<`[`SurfacePoint`]`>` (face, barycentric,
+//!   distance), exact, through a [`SurfaceIndex`] (build once, query many);
+//! - [`nearest_point_labels`]`(source, source_face_labels, target, &transform)` and
+//!   [`nearest_point_vertex_labels`] (per-vertex source labels): `(Vec<i32>, Vec<f64>)`, a
+//!   label and a distance per target vertex.
+
+mod closest_surface_points;
+mod nearest_point_labels;
+mod register_pair;
+mod similarity;
+mod surface_samples;
+
+pub use closest_surface_points::{SurfaceIndex, SurfacePoint, closest_surface_points};
+pub use nearest_point_labels::{nearest_point_labels, nearest_point_vertex_labels};
+pub use register_pair::{Candidate, RegisterOptions, Registration, register_pair};
+pub use similarity::Similarity;
+
+use thiserror::Error;
+
+/// Errors of the alignment stage.
+#[derive(Debug, Error)]
+pub enum AlignError {
+    /// An option is out of range.
+    #[error("invalid option: {0}")]
+    BadOption(String),
+    /// A shape cannot be registered (no area, no extent).
+    #[error("{0}")]
+    Degenerate(String),
+    /// Labels do not match the mesh they are given for.
+    #[error("{found} {kind} labels for a mesh with {expected} {kind}s")]
+    LabelCount {
+        /// Faces or vertices of the mesh.
+        expected: usize,
+        /// Labels given.
+        found: usize,
+        /// "face" or "vertex".
+        kind: &'static str,
+    },
+}

@@ -1,0 +1,90 @@
+//! [`nearest_point_labels`]: labels carried from a source onto a registered target, each target
+//! vertex taking the label of the nearest point of the source's surface (the rigid baseline of
+//! label transfer).
+
+use super::AlignError;
+use super::closest_surface_points::SurfaceIndex;
+use super::similarity::Similarity;
+use crate::mesh::TriMesh;
+use rayon::prelude::*;
+
+/// Per-vertex labels of `target` from per-face labels of `source`, through `transform`
+/// (target onto source, as [`register_pair`](super::register_pair) returns it).
+///
+/// - `source`: the labelled shape (`F` faces); `source_face_labels`: `F` labels (any `i32`;
+///   negative values are carried like any other);
+/// - `target`: the shape to label (`V` vertices); `transform`: target points into the source's
+///   frame;
+/// - returns `(labels, distances)`: `V` labels, and for each target vertex the distance (in
+///   source units) from its transformed position to the source surface point whose label it
+///   took — a large distance marks a vertex where the shapes differ.
+///
+/// Errors: [`AlignError::LabelCount`] when the labels do not match the source's faces.
+///
+/// See also: [`nearest_point_vertex_labels`] (per-vertex source labels),
+/// [`closest_surface_points`](super::closest_surface_points).
+///
+/// Known issues: the nearest point is Euclidean: where two parts of the source come close (a
+/// chair's arm over its seat) a target vertex may take the label across the gap.
+pub fn nearest_point_labels(
+    source: &TriMesh,
+    source_face_labels: &[i32],
+    target: &TriMesh,
+    transform: &Similarity,
+) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
+    if source_face_labels.len() != source.face_count() {
+        return Err(AlignError::LabelCount {
+            expected: source.face_count(),
+            found: source_face_labels.len(),
+            kind: "face",
+        });
+    }
+    let index = SurfaceIndex::new(source);
+    Ok(target
+        .positions()
+        .par_iter()
+        .map(|&p| {
+            let c = index.closest(transform.apply(p));
+            (source_face_labels[c.face], c.distance)
+        })
+        .unzip())
+}
+
+/// [`nearest_point_labels`] with per-vertex source labels: each target vertex takes the label
+/// of the corner of the nearest source face that carries the largest barycentric weight (the
+/// source vertex nearest to the closest surface point, on its face).
+///
+/// - `source_vertex_labels`: one label per source vertex;
+/// - returns `(labels, distances)` as [`nearest_point_labels`].
+///
+/// Errors: [`AlignError::LabelCount`] when the labels do not match the source's vertices.
+pub fn nearest_point_vertex_labels(
+    source: &TriMesh,
+    source_vertex_labels: &[i32],
+    target: &TriMesh,
+    transform: &Similarity,
+) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
+    if source_vertex_labels.len() != source.vertex_count() {
+        return Err(AlignError::LabelCount {
+            expected: source.vertex_count(),
+            found: source_vertex_labels.len(),
+            kind: "vertex",
+        });
+    }
+    let index = SurfaceIndex::new(source);
+    let faces = source.faces();
+    Ok(target
+        .positions()
+        .par_iter()
+        .map(|&p| {
+            let c = index.closest(transform.apply(p));
+            let mut k = 0;
+            for i in 1..3 {
+                if c.barycentric[i] > c.barycentric[k] {
+                    k = i;
+                }
+            }
+            (source_vertex_labels[faces[c.face][k] as usize], c.distance)
+        })
+        .unzip())
+}
