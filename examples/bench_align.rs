@@ -3,14 +3,21 @@
 //! ```text
 //! # Every mesh registered onto the first one (each a moved copy of itself with --self).
 //! cargo run --release --example bench_align -- pairs [--self] MESH...
+//! # A collection aligned (align_collection), optionally every shape first moved by a seeded
+//! # random similarity (rotation uniform, scale 0.5–2, translation ±10): the rotation error of
+//! # each shape against the collection's common frame (the rotation of recovered ∘ true that most shapes share, within 5°).
+//! cargo run --release --example bench_align -- collection [--move SEED] MESH...
 //! ```
 
-use coseg::align::{RegisterOptions, register_pair};
+use coseg::align::{AlignOptions, RegisterOptions, Similarity, align_collection, register_pair};
 use coseg::mesh::read_mesh;
 use std::time::Instant;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("collection") {
+        return collection(&args[1..]);
+    }
     let own = args.iter().any(|a| a == "--self");
     let files: Vec<&String> = args[1..].iter().filter(|a| !a.starts_with("--")).collect();
     let meshes = files.iter().map(read_mesh).collect::<Result<Vec<_>, _>>()?;
@@ -42,4 +49,136 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         total / meshes.len() as f64
     );
     Ok(())
+}
+
+fn unit(rng: &mut rand_chacha::ChaCha8Rng) -> f64 {
+    use rand_chacha::rand_core::Rng;
+    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Uniform rotation (unit quaternion from four normals), scale 0.5–2, translation ±10.
+fn random_similarity(rng: &mut rand_chacha::ChaCha8Rng) -> Similarity {
+    let mut q = [0.0f64; 4];
+    for k in 0..2 {
+        let (u1, u2) = (unit(rng).max(1e-12), unit(rng));
+        let r = (-2.0 * u1.ln()).sqrt();
+        q[2 * k] = r * (std::f64::consts::TAU * u2).cos();
+        q[2 * k + 1] = r * (std::f64::consts::TAU * u2).sin();
+    }
+    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let [w, x, y, z] = q.map(|v| v / n);
+    Similarity {
+        rotation: [
+            [
+                1.0 - 2.0 * (y * y + z * z),
+                2.0 * (x * y - w * z),
+                2.0 * (x * z + w * y),
+            ],
+            [
+                2.0 * (x * y + w * z),
+                1.0 - 2.0 * (x * x + z * z),
+                2.0 * (y * z - w * x),
+            ],
+            [
+                2.0 * (x * z - w * y),
+                2.0 * (y * z + w * x),
+                1.0 - 2.0 * (x * x + y * y),
+            ],
+        ],
+        scale: 0.5 * 4f64.powf(unit(rng)),
+        translation: [0, 1, 2].map(|_| 20.0 * unit(rng) - 10.0),
+    }
+}
+
+fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
+    use rand::SeedableRng;
+    let mut seed = None;
+    let mut files = Vec::new();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        match a.as_str() {
+            "--move" => seed = Some(it.next().ok_or("--move SEED")?.parse::<u64>()?),
+            _ => files.push(a.clone()),
+        }
+    }
+    let mut meshes = files.iter().map(read_mesh).collect::<Result<Vec<_>, _>>()?;
+    let mut truth = vec![Similarity::identity(); meshes.len()];
+    if let Some(s) = seed {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(s);
+        for (m, t) in meshes.iter_mut().zip(truth.iter_mut()) {
+            *t = random_similarity(&mut rng);
+            *m = m.map_positions(|p| t.apply(p))?;
+        }
+    }
+    let vertices: usize = meshes.iter().map(|m| m.vertex_count()).sum();
+    let t = Instant::now();
+    let a = align_collection(&meshes, &AlignOptions::default())?;
+    let wall = t.elapsed().as_secs_f64();
+    // recovered ∘ true: the same rotation for every shape when the frame is right.
+    let net: Vec<Similarity> = a
+        .shapes
+        .iter()
+        .zip(&truth)
+        .map(|(s, t)| s.transform.compose(t))
+        .collect();
+    // The common frame: the shapes' net rotation that most others are within 5° of, refined
+    // by the chordal mean of those.
+    let support = |c: &Similarity| net.iter().filter(|s| s.rotation_angle_to(c) <= 5.0).count();
+    let seed_frame = net
+        .iter()
+        .max_by_key(|c| support(c))
+        .copied()
+        .unwrap_or_else(Similarity::identity);
+    let mut m = [[0.0; 3]; 3];
+    for s in net
+        .iter()
+        .filter(|s| s.rotation_angle_to(&seed_frame) <= 5.0)
+    {
+        for (row, r) in m.iter_mut().zip(&s.rotation) {
+            for (x, y) in row.iter_mut().zip(r) {
+                *x += y;
+            }
+        }
+    }
+    let mean = nearest_rotation(m);
+    let mut within = 0;
+    for ((f, s), sh) in files.iter().zip(&net).zip(&a.shapes) {
+        let e = s.rotation_angle_to(&mean);
+        within += usize::from(e <= 5.0);
+        println!(
+            "{f}\terror {e:.1}°\tconfidence {:.2}\tresidual {}\tambiguity {}",
+            sh.confidence,
+            sh.residual.map_or("-".into(), |r| format!("{r:.4}")),
+            sh.ambiguity
+                .zip(sh.ambiguity_angle)
+                .map_or("-".into(), |(x, g)| format!("{x:.2} at {g:.0}°"))
+        );
+    }
+    println!(
+        "{:?}: {} shapes ({vertices} vertices), {} edges, given-frame share {:.2}, up {:?}, forward {:?}; within 5° of the common frame: {within} of {} ({:.1} %); {wall:.2} s wall ({:.3} s per shape)",
+        a.case,
+        meshes.len(),
+        a.edges.len(),
+        a.given_frame_share,
+        a.up.map(|x| (x * 1000.0).round() / 1000.0),
+        a.forward.map(|x| (x * 1000.0).round() / 1000.0),
+        meshes.len(),
+        100.0 * within as f64 / meshes.len() as f64,
+        wall / meshes.len() as f64
+    );
+    Ok(())
+}
+
+/// The rotation nearest to `m` (SVD projection).
+fn nearest_rotation(m: [[f64; 3]; 3]) -> Similarity {
+    let a = nalgebra::Matrix3::from_fn(|i, j| m[i][j]);
+    let svd = a.svd(true, true);
+    let (u, vt) = (svd.u.unwrap(), svd.v_t.unwrap());
+    let d = (u * vt).determinant().signum();
+    let r = u * nalgebra::Matrix3::from_diagonal(&nalgebra::Vector3::new(1.0, 1.0, d)) * vt;
+    Similarity {
+        rotation: std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
+        scale: 1.0,
+        translation: [0.0; 3],
+    }
 }

@@ -25,9 +25,16 @@
 //! and `B` of the ground truth of the listed shapes (annotations and scoring alike), e.g.
 //! `--gt-swap 101,102,103,109,110:1=3` (docs/PROPAGATION.md: those five files label the back
 //! 3 and the legs 1, the other seventeen the reverse).
+//! `--route rigid`: instead of `coseg propagate`, the rigid baseline on the same sources and
+//! targets: each target registered onto a source by `coseg::align::register_pair` (similarity,
+//! any pose) and every target vertex given the label of the nearest source surface point
+//! (`coseg::align::nearest_point_vertex_labels`, from the per-vertex annotation); from several
+//! sources, each target from its best-registered source (lowest residual).
+//! `labelled` scores grouped parts (the manifest's `part_groups`, as `coseg::evaluate` does).
 //! Accuracy is area-weighted: per face against `.seg` files for the chairs, per vertex for
 //! the identity sets; the source shapes are left out of every mean.
 
+use coseg::align::{RegisterOptions, Registration, nearest_point_vertex_labels, register_pair};
 use coseg::bands::BandWeighting;
 use coseg::evaluate::{face_label_agreement, vertex_label_agreement};
 use coseg::features::{parse_alignment, parse_families, parse_family_weights};
@@ -40,7 +47,9 @@ use coseg::spectral::HeatSmoother;
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rayon::prelude::*;
+use std::collections::HashMap;
 use std::path::PathBuf;
+use std::sync::Mutex;
 use std::time::Instant;
 
 struct Set {
@@ -48,6 +57,8 @@ struct Set {
     meshes: Vec<TriMesh>,
     graph: ShapeGraph,
     smoothers: Option<Vec<HeatSmoother>>,
+    /// `--route rigid`: registrations `(source, target)` computed so far.
+    rigid: Option<Mutex<HashMap<(usize, usize), Registration>>>,
 }
 
 fn load(
@@ -100,6 +111,7 @@ fn load(
         meshes,
         graph,
         smoothers,
+        rigid: None,
     })
 }
 
@@ -112,6 +124,9 @@ fn run(
     options: &PropagateOptions,
 ) -> Result<Vec<(usize, f64)>, Box<dyn std::error::Error>> {
     let n = set.names.len();
+    if let Some(cache) = &set.rigid {
+        return rigid(set, cache, sources, annotation, score);
+    }
     let ann: Vec<Option<Vec<i32>>> = (0..n)
         .map(|i| sources.contains(&i).then(|| annotation(i)))
         .collect();
@@ -120,6 +135,58 @@ fn run(
         .filter(|i| !sources.contains(i))
         .map(|i| (i, score(i, &p.labels[i])))
         .collect())
+}
+
+/// The rigid baseline: every target registered onto each source (similarity, any pose), its
+/// labels from the best-registered source's nearest surface points.
+fn rigid(
+    set: &Set,
+    cache: &Mutex<HashMap<(usize, usize), Registration>>,
+    sources: &[usize],
+    annotation: &dyn Fn(usize) -> Vec<i32>,
+    score: &dyn Fn(usize, &[i32]) -> f64,
+) -> Result<Vec<(usize, f64)>, Box<dyn std::error::Error>> {
+    let n = set.names.len();
+    let targets: Vec<usize> = (0..n).filter(|i| !sources.contains(i)).collect();
+    let pairs: Vec<(usize, usize)> = targets
+        .iter()
+        .flat_map(|&t| sources.iter().map(move |&s| (s, t)))
+        .filter(|k| !cache.lock().unwrap().contains_key(k))
+        .collect();
+    let o = RegisterOptions::default();
+    let new: Vec<((usize, usize), Registration)> = pairs
+        .par_iter()
+        .map(|&(s, t)| {
+            register_pair(&set.meshes[s], &set.meshes[t], &o)
+                .map(|r| ((s, t), r))
+                .map_err(|e| format!("{} onto {}: {e}", set.names[t], set.names[s]))
+        })
+        .collect::<Result<_, _>>()?;
+    cache.lock().unwrap().extend(new);
+    let regs = cache.lock().unwrap();
+    let labels: Vec<Option<Vec<i32>>> = sources.iter().map(|&s| Some(annotation(s))).collect();
+    targets
+        .iter()
+        .map(|&t| {
+            let (k, s) = sources
+                .iter()
+                .enumerate()
+                .min_by(|a, b| {
+                    regs[&(*a.1, t)]
+                        .residual
+                        .total_cmp(&regs[&(*b.1, t)].residual)
+                })
+                .unwrap();
+            let l = labels[k].as_ref().unwrap();
+            let (lt, _) = nearest_point_vertex_labels(
+                &set.meshes[*s],
+                l,
+                &set.meshes[t],
+                &regs[&(*s, t)].transform,
+            )?;
+            Ok((t, score(t, &lt)))
+        })
+        .collect()
 }
 
 fn mean(x: &[(usize, f64)]) -> f64 {
@@ -228,6 +295,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut normals = 0usize;
     let mut parts_from = "voronoi".to_string();
     let mut map_step = false;
+    let mut route_rigid = false;
     let mut swaps: Vec<(Vec<String>, i32, i32)> = Vec::new();
     let (mut seg, mut reps): (Option<PathBuf>, usize) = (None, 3);
     while let Some(a) = args.next() {
@@ -257,6 +325,13 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--parts" => parts = val()?.parse()?,
             "--parts-from" => parts_from = val()?,
             "--map-step" => map_step = true,
+            "--route" => {
+                route_rigid = match val()?.as_str() {
+                    "rigid" => true,
+                    "coseg" => false,
+                    o => return Err(format!("--route {o}: coseg or rigid").into()),
+                }
+            }
             "--seg" => seg = Some(PathBuf::from(val()?)),
             "--reps" => reps = val()?.parse()?,
             "--per-target" => per_target = true,
@@ -313,7 +388,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .and_then(|s| s.parse::<u64>().ok())
                     .unwrap_or(u64::MAX)
             });
-            let set = load(&files, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let mut set = load(&files, &cache, &pipeline, &graph, options.smoothing_time)?;
+            if route_rigid {
+                set.rigid = Some(Mutex::default());
+            }
             let mut gt: Vec<Vec<i32>> = set
                 .names
                 .iter()
@@ -373,11 +451,21 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // A shipped collection: meshes and `<stem>.labels.txt` (per vertex) in one folder.
             let dir = rest.first().ok_or("labelled DIR")?;
             let files = coseg::graph::mesh_files(dir)?;
-            let set = load(&files, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let mut set = load(&files, &cache, &pipeline, &graph, options.smoothing_time)?;
+            if route_rigid {
+                set.rigid = Some(Mutex::default());
+            }
+            let groups = part_groups(dir)?;
             let gt: Vec<Vec<i32>> = set
                 .names
                 .iter()
-                .map(|n| Ok(read_label_file(&dir.join(format!("{n}.labels.txt")))?.1))
+                .map(|n| {
+                    let raw = read_label_file(&dir.join(format!("{n}.labels.txt")))?.1;
+                    Ok(match &groups {
+                        Some(g) => g.apply(&raw)?.into_iter().map(|x| x as i32).collect(),
+                        None => raw,
+                    })
+                })
                 .collect::<Result<_, Box<dyn std::error::Error>>>()?;
             let ann = |i: usize| gt[i].clone();
             let score = |i: usize, l: &[i32]| {
@@ -414,7 +502,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bench(&set, &ann, &options, reps, t_load)
         }
         "identity" => {
-            let set = load(&rest, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let mut set = load(&rest, &cache, &pipeline, &graph, options.smoothing_time)?;
+            if route_rigid {
+                set.rigid = Some(Mutex::default());
+            }
             let truth = match parts_from.as_str() {
                 "voronoi" => voronoi_parts(&set.meshes[0], parts),
                 "features" => {
@@ -484,6 +575,20 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     }
 }
 
+/// The manifest's part groups (`manifest.json`: `parts`, `part_groups`), if the folder has one.
+fn part_groups(
+    dir: &std::path::Path,
+) -> Result<Option<coseg::evaluate::PartGroups>, Box<dyn std::error::Error>> {
+    let Ok(text) = std::fs::read_to_string(dir.join("manifest.json")) else {
+        return Ok(None);
+    };
+    let m: serde_json::Value = serde_json::from_str(&text)?;
+    let parts: Vec<String> = serde_json::from_value(m["parts"].clone())?;
+    let groups: std::collections::BTreeMap<String, Vec<String>> =
+        serde_json::from_value(m["part_groups"].clone()).unwrap_or_default();
+    Ok(Some(coseg::evaluate::group_parts(&parts, &groups)?))
+}
+
 fn chairs(
     set: &Set,
     ann: &dyn Fn(usize) -> Vec<i32>,
@@ -533,7 +638,9 @@ fn chairs(
         set.names[ws],
         100.0 * wsv
     );
-    if let Err(e) = incremental(set, ann, score, options) {
+    if set.rigid.is_some() {
+        println!("\nincremental: not run (rigid route)");
+    } else if let Err(e) = incremental(set, ann, score, options) {
         println!("\nincremental: not run ({e})");
     }
     if triples == 0 {

@@ -2,8 +2,8 @@
 //! moved copies, nearest-point labels.
 
 use coseg::align::{
-    AlignError, RegisterOptions, Similarity, closest_surface_points, nearest_point_labels,
-    nearest_point_vertex_labels, register_pair,
+    AlignError, AlignOptions, FrameCase, RegisterOptions, Similarity, align_collection,
+    closest_surface_points, nearest_point_labels, nearest_point_vertex_labels, register_pair,
 };
 use coseg::mesh::{TriMesh, read_mesh};
 use rand::SeedableRng;
@@ -201,4 +201,53 @@ fn nearest_point_labels_reject_a_wrong_label_count() {
         "{err}"
     );
     assert!(err.to_string().contains("face labels"));
+}
+
+fn family(name: &str) -> Vec<TriMesh> {
+    (0..6).map(|i| shipped(name, i)).collect()
+}
+
+/// The shipped families are generated in one frame: detected, every transform the identity
+/// bit for bit.
+#[test]
+fn align_collection_keeps_already_aligned_frames_exactly() {
+    for name in ["chairs", "quadrupeds"] {
+        let a = align_collection(&family(name), &AlignOptions::default()).unwrap();
+        assert_eq!(
+            a.case,
+            FrameCase::AlreadyAligned,
+            "{name}: {}",
+            a.given_frame_share
+        );
+        assert!(a.shapes.iter().all(|s| s.transform.is_identity()));
+    }
+}
+
+/// Quadrupeds moved at random: synchronised, every shape's recovered rotation composed with
+/// its true motion is one common rotation (within 5°).
+#[test]
+fn align_collection_recovers_moved_quadrupeds() {
+    let mut rng = ChaCha8Rng::seed_from_u64(1);
+    let mut truth = Vec::new();
+    let moved: Vec<TriMesh> = family("quadrupeds")
+        .into_iter()
+        .map(|m| {
+            let t = random_similarity(&mut rng);
+            truth.push(t);
+            m.map_positions(|p| t.apply(p)).unwrap()
+        })
+        .collect();
+    let a = align_collection(&moved, &AlignOptions::default()).unwrap();
+    assert_eq!(a.case, FrameCase::Synchronised);
+    let net: Vec<Similarity> = a
+        .shapes
+        .iter()
+        .zip(&truth)
+        .map(|(s, t)| s.transform.compose(t))
+        .collect();
+    for n in &net {
+        assert!(n.rotation_angle_to(&net[0]) < 5.0, "{n:?}");
+    }
+    let again = align_collection(&moved, &AlignOptions::default()).unwrap();
+    assert_eq!(a, again);
 }

@@ -12,13 +12,23 @@
 //! - [`nearest_point_labels`]`(source, source_face_labels, target, &transform)` and
 //!   [`nearest_point_vertex_labels`] (per-vertex source labels): `(Vec<i32>, Vec<f64>)`, a
 //!   label and a distance per target vertex.
+//!
+//! Collections:
+//! - [`align_collection`]`(meshes, &`[`AlignOptions`]`) -> Result<`[`CollectionAlignment`]`, `[`AlignError`]`>`:
+//!   a similarity per shape into one collection frame (registrations over a shape graph,
+//!   synchronised), a confidence per shape, the already-aligned case kept exactly, the up and
+//!   forward axes.
 
+mod align_collection;
 mod closest_surface_points;
 mod nearest_point_labels;
 mod register_pair;
 mod similarity;
 mod surface_samples;
 
+pub use align_collection::{
+    AlignOptions, CollectionAlignment, FrameCase, ShapeAlignment, align_collection,
+};
 pub use closest_surface_points::{SurfaceIndex, SurfacePoint, closest_surface_points};
 pub use nearest_point_labels::{nearest_point_labels, nearest_point_vertex_labels};
 pub use register_pair::{Candidate, RegisterOptions, Registration, register_pair};

@@ -25,7 +25,6 @@ pub(crate) struct Moments {
     /// rotation (determinant +1).
     pub frame: Matrix3<f64>,
     /// Variances along the principal axes, decreasing, in units of `radius²` (sum 1).
-    #[allow(dead_code)] // the collection stage's shape descriptor reads it
     pub spectrum: [f64; 3],
 }
 
