@@ -17,9 +17,12 @@
 //! - [`align_collection`]`(meshes, &`[`AlignOptions`]`) -> Result<`[`CollectionAlignment`]`, `[`AlignError`]`>`:
 //!   a similarity per shape into one collection frame (registrations over a shape graph,
 //!   synchronised), a confidence per shape, the already-aligned case kept exactly, the up and
-//!   forward axes.
+//!   forward axes;
+//! - [`align_folder`]: `coseg align FOLDER -o OUT` as a job (`transforms.json`, aligned meshes
+//!   on request).
 
 mod align_collection;
+mod align_folder;
 mod closest_surface_points;
 mod nearest_point_labels;
 mod register_pair;
@@ -29,6 +32,7 @@ mod surface_samples;
 pub use align_collection::{
     AlignOptions, CollectionAlignment, FrameCase, ShapeAlignment, align_collection,
 };
+pub use align_folder::{AlignFolderOptions, AlignFolderReport, align_folder};
 pub use closest_surface_points::{SurfaceIndex, SurfacePoint, closest_surface_points};
 pub use nearest_point_labels::{nearest_point_labels, nearest_point_vertex_labels};
 pub use register_pair::{Candidate, RegisterOptions, Registration, register_pair};
@@ -45,6 +49,24 @@ pub enum AlignError {
     /// A shape cannot be registered (no area, no extent).
     #[error("{0}")]
     Degenerate(String),
+    /// A file could not be read or written.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file or folder concerned.
+        path: String,
+        /// The underlying error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A mesh could not be read or written.
+    #[error("{path}: {source}")]
+    Mesh {
+        /// The file concerned.
+        path: String,
+        /// The mesh error.
+        #[source]
+        source: crate::mesh::MeshError,
+    },
     /// Labels do not match the mesh they are given for.
     #[error("{found} {kind} labels for a mesh with {expected} {kind}s")]
     LabelCount {

@@ -1,5 +1,6 @@
 //! Subcommands of the `coseg` binary, one file each, and the flags they share.
 
+mod align;
 mod convert;
 mod eval;
 mod features;
@@ -71,6 +72,12 @@ enum Command {
     /// Convert a mesh between OBJ, OFF and PLY (format by extension), keeping vertex order.
     #[command(after_help = "Example:\n  coseg convert cat0.off cat0.ply")]
     Convert(convert::ConvertArgs),
+    /// Put every mesh of a folder in one collection frame (rotation, scale, translation).
+    #[command(
+        after_help = "Example:\n  coseg align shapes/ -o aligned/ --write-meshes\n\
+        Writes aligned/transforms.json (see docs/ALIGN.md) and, on request, the aligned meshes."
+    )]
+    Align(align::AlignArgs),
     /// Compute a mesh's descriptors and band table and export them (.npy or .csv).
     #[command(after_help = "Example:\n  coseg features cat0.off -o cat0_features/")]
     Features(features::FeaturesArgs),
@@ -179,6 +186,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Info(args) => info::run(args),
         Command::Spectrum(args) => spectrum::run(args),
         Command::Convert(args) => convert::run(args),
+        Command::Align(args) => align::run(args),
         Command::Features(args) => features::run(args),
         Command::Generate(args) => generate::run(args),
         Command::Pair(args) => pair::run(args),
