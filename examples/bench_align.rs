@@ -6,7 +6,7 @@
 //! # A collection aligned (align_collection), optionally every shape first moved by a seeded
 //! # random similarity (rotation uniform, scale 0.5–2, translation ±10): the rotation error of
 //! # each shape against the collection's common frame (the rotation of recovered ∘ true that most shapes share, within 5°).
-//! cargo run --release --example bench_align -- collection [--move SEED] MESH...
+//! cargo run --release --example bench_align -- collection [--move SEED] [--neighbours K] MESH...
 //! ```
 
 use coseg::align::{AlignOptions, RegisterOptions, Similarity, align_collection, register_pair};
@@ -94,10 +94,12 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     use rand::SeedableRng;
     let mut seed = None;
     let mut files = Vec::new();
+    let mut options = AlignOptions::default();
     let mut it = args.iter();
     while let Some(a) = it.next() {
         match a.as_str() {
             "--move" => seed = Some(it.next().ok_or("--move SEED")?.parse::<u64>()?),
+            "--neighbours" => options.neighbours = it.next().ok_or("--neighbours K")?.parse()?,
             _ => files.push(a.clone()),
         }
     }
@@ -112,7 +114,7 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     }
     let vertices: usize = meshes.iter().map(|m| m.vertex_count()).sum();
     let t = Instant::now();
-    let a = align_collection(&meshes, &AlignOptions::default())?;
+    let a = align_collection(&meshes, &options)?;
     let wall = t.elapsed().as_secs_f64();
     // recovered ∘ true: the same rotation for every shape when the frame is right.
     let net: Vec<Similarity> = a
