@@ -11,9 +11,8 @@
 //! ground-truth part. Coverage: how much of each part one region covers, on all shapes at once.
 
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
-use coseg::graph::{
-    Cosegmentation, LoadedCollection, SegmentCollectionOptions, load_collection, segment_collection,
-};
+use coseg::graph::{Cosegmentation, LoadedCollection, load_collection};
+use coseg::parts::{SegmentCollectionOptions, segment_collection};
 use coseg::pipeline::ShapePipelineOptions;
 use std::path::PathBuf;
 

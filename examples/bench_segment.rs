@@ -11,8 +11,9 @@
 //! `load_collection` reads them). Mesh reading is reported apart.
 
 use coseg::cache::{CacheOutcome, bands_path, cache_path};
-use coseg::graph::{SegmentCollectionOptions, SegmentTimes, ShapeNode, segment_collection};
+use coseg::graph::ShapeNode;
 use coseg::mesh::read_mesh;
+use coseg::parts::{SegmentCollectionOptions, SegmentTimes, segment_collection};
 use coseg::pipeline::{
     ShapeBands, ShapePipelineOptions, encode_bands_entry, encode_shape_entry as encode_entry,
     load_or_compute_bands, shape_data_from_spectrum, shape_key,

@@ -12,10 +12,10 @@
 
 use coseg::affinity::BandAffinity;
 use coseg::graph::{
-    CosegmentOptions, GraphOptions, SegmentCollectionOptions, ShapeGraph, ShapeNode, cosegment,
-    refine_cosegmentation,
+    CosegmentOptions, GraphOptions, ShapeGraph, ShapeNode, cosegment, refine_cosegmentation,
 };
 use coseg::mesh::read_mesh;
+use coseg::parts::SegmentCollectionOptions;
 use coseg::pipeline::{ShapePipelineOptions, load_or_compute};
 use coseg::spectral::HeatSmoother;
 use coseg::stable::RefineOptions;

@@ -25,10 +25,8 @@
 //! coverage of the grouped parts (`coseg::evaluate`).
 
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity};
-use coseg::graph::{
-    AdaptiveOptions, Cosegmentation, LoadedCollection, PartsFrom, SegmentCollectionOptions,
-    load_collection, segment_collection,
-};
+use coseg::graph::{Cosegmentation, LoadedCollection, load_collection};
+use coseg::parts::{AdaptiveOptions, PartsFrom, SegmentCollectionOptions, segment_collection};
 use coseg::pipeline::ShapePipelineOptions;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -177,7 +175,7 @@ fn mirror_check(
     seg: &Cosegmentation,
     folder: &Path,
     up: Option<[f64; 3]>,
-    likeness: coseg::graph::Likeness<'_>,
+    likeness: coseg::parts::Likeness<'_>,
 ) -> Res<String> {
     let truth = GroundTruth::read(folder)?;
     let names = &truth.manifest.parts;
@@ -198,7 +196,7 @@ fn mirror_check(
             .unwrap_or(0);
         format!("{r} {}", names.get(k).map_or("?", String::as_str))
     };
-    let pairs = coseg::graph::mirror_pairs(&loaded.meshes, seg, up, Some(likeness));
+    let pairs = coseg::parts::mirror_pairs(&loaded.meshes, seg, up, Some(likeness));
     Ok(pairs
         .iter()
         .map(|m| {
@@ -299,7 +297,7 @@ fn main() -> Res<()> {
             .meshes
             .iter()
             .map(|m| {
-                coseg::graph::mirror_plane(m).map_or("-".into(), |p| format!("{:.3}", p.error))
+                coseg::parts::mirror_plane(m).map_or("-".into(), |p| format!("{:.3}", p.error))
             })
             .collect();
         println!("mirror plane errors: {}", errors.join(" "));
@@ -341,11 +339,11 @@ fn main() -> Res<()> {
             })
             .collect();
         let extra = out.adaptive.as_ref().map_or(String::new(), |a| {
-            let pairs = coseg::graph::mirror_pairs(
+            let pairs = coseg::parts::mirror_pairs(
                 &loaded.meshes,
                 &a.leaves,
                 o.up,
-                Some(coseg::graph::Likeness {
+                Some(coseg::parts::Likeness {
                     graph: &out.graph,
                     columns: &o.mirror_columns,
                 }),
@@ -362,7 +360,7 @@ fn main() -> Res<()> {
             )
         });
         if mirrors && !coseg_set {
-            let likeness = coseg::graph::Likeness {
+            let likeness = coseg::parts::Likeness {
                 graph: &out.graph,
                 columns: &o.mirror_columns,
             };
@@ -398,7 +396,7 @@ fn main() -> Res<()> {
         };
         println!(
             "{mode:>12}: {score}  confidence {:.3}  parts {} (median sizes % {}){extra}  {secs:.2} s",
-            coseg::graph::start_score(seg),
+            coseg::parts::start_score(seg),
             seg.tuples.len(),
             sizes.join("/")
         );

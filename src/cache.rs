@@ -27,7 +27,7 @@
 //! |---|---|---|---|
 //! | `<key>.coseg-shape` ([`EntryKind::Full`]) | [`crate::pipeline::StoredShape`] | eigenvalues (f64), eigenvectors (**f32**, `d × k`), vertex areas (f64), the sdf and user feature columns (f64) when those families are on, band table (u8 `d × N`, deflated inside the payload) | `4·d·k + 8·d + d·N/6` (10k vertices: 8.6 MB) |
 //! | `<key>.coseg-bands` ([`EntryKind::Bands`]) | [`crate::pipeline::ShapeBands`] | band table (u8, `d × N`), vertex areas (f64), the whole payload deflated | about `d·N / 6 + 8·d` (10k: 0.5 MB) |
-//! | `<key>.coseg-cues` ([`EntryKind::PartCues`], only with `--parts-from geometry`; key: the mesh and the SDF options, not the feature options) | [`crate::graph::PartCues`] | thickness and mean curvature (f64) | `16·d` (10k: 0.16 MB) |
+//! | `<key>.coseg-cues` ([`EntryKind::PartCues`], only with `--parts-from geometry`; key: the mesh and the SDF options, not the feature options) | [`crate::parts::PartCues`] | thickness and mean curvature (f64) | `16·d` (10k: 0.16 MB) |
 //!
 //! The descriptors (spectral and extrinsic) are not in the full entry: a warm load recomputes
 //! them from the stored spectrum with the cold run's own code
@@ -69,7 +69,7 @@ pub enum EntryKind {
     Full,
     /// The compact entry: band table and vertex areas only.
     Bands,
-    /// The geometric cues of part boundaries ([`crate::graph::PartCues`]: thickness and mean
+    /// The geometric cues of part boundaries ([`crate::parts::PartCues`]: thickness and mean
     /// curvature per vertex), for `--parts-from geometry`; keyed by the mesh alone.
     PartCues,
 }

@@ -18,7 +18,8 @@
 //! | correspondence maps | [`maps`] | functional maps, ZoomOut, one-to-one matches, map presets |
 //! | affinity | [`affinity`] | the band-table affinity operator `W x`, `Wᵀ y` (never dense) |
 //! | stable regions | [`stable`] | Algorithms 1–3 of the paper between two shapes |
-//! | collections | [`graph`] | shape graph and cycle solver for consistent co-segmentation |
+//! | collections | [`graph`] | shape graph, cycle solver, consistent co-segmentation and its refinement |
+//! | parts | [`parts`] | regions to parts: parts of their own size, part trees, mirror pairs, crease snapping; the whole collection stage of `coseg segment` ([`parts::segment_collection`]) |
 //! | part labels | [`labels`] | annotation files (per vertex, `.seg` per face), vertex ↔ face conversion |
 //! | propagation | [`propagate`] | part labels carried from annotated shapes to a collection |
 //! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view, the palette) |
@@ -40,6 +41,7 @@ pub mod labels;
 pub mod maps;
 pub mod mesh;
 pub mod output;
+pub mod parts;
 pub mod pipeline;
 pub mod propagate;
 pub mod render;

@@ -1,10 +1,12 @@
-//! Tests of the adaptive co-segmentation (parts of their own size, `coseg::graph::adaptive_cosegment`).
+//! Tests of the adaptive co-segmentation (parts of their own size, `coseg::parts::adaptive_cosegment`).
 
 use coseg::bands::{BandTable, equal_count_bands};
 use coseg::graph::{
-    AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphOptions, PartTree, RefineSizes,
-    ShapeGraph, ShapeNode, Sizing, StopReason, adaptive_cosegment, adaptive_update, cosegment,
+    CosegmentOptions, Cosegmentation, GraphOptions, RefineSizes, ShapeGraph, ShapeNode, cosegment,
     refine_cosegmentation, refine_cosegmentation_sized,
+};
+use coseg::parts::{
+    AdaptiveOptions, PartTree, Sizing, StopReason, adaptive_cosegment, adaptive_update,
 };
 use coseg::stable::RefineOptions;
 use rand_chacha::ChaCha8Rng;
@@ -183,17 +185,17 @@ fn tree_cut_groups_leaves() {
     let t = PartTree {
         leaves: 4,
         merges: vec![
-            coseg::graph::PartMerge {
+            coseg::parts::PartMerge {
                 a: 1,
                 b: 3,
                 similarity: 0.9,
             },
-            coseg::graph::PartMerge {
+            coseg::parts::PartMerge {
                 a: 0,
                 b: 4,
                 similarity: 0.7,
             },
-            coseg::graph::PartMerge {
+            coseg::parts::PartMerge {
                 a: 5,
                 b: 2,
                 similarity: 0.1,

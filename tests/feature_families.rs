@@ -412,7 +412,8 @@ fn a_missing_user_file_names_the_folder_and_the_shape() {
 #[test]
 fn a_collection_mixing_families_is_deterministic_bit_for_bit() {
     use coseg::features::{FeatureFamilies, parse_families};
-    use coseg::graph::{SegmentCollectionOptions, ShapeNode, segment_collection};
+    use coseg::graph::ShapeNode;
+    use coseg::parts::{SegmentCollectionOptions, segment_collection};
     use coseg::pipeline::compute_shape_data;
     let meshes = [blob(2), similarity(&blob(2), 2.0), icosphere(2)];
     let mut o = small_pipeline();

@@ -1,4 +1,4 @@
-//! Tests of the geometric part tree (`graph::geometric_part_tree`: thickness and boundary
+//! Tests of the geometric part tree (`parts::geometric_part_tree`: thickness and boundary
 //! concavity) and of `--parts N --parts-from geometry` (`SegmentCollectionOptions::parts_from`).
 
 mod common;
@@ -6,12 +6,12 @@ mod common;
 use common::graph::{coseg_of, uniform_cues};
 use coseg::bands::equal_count_bands;
 use coseg::cache::CacheOutcome;
-use coseg::graph::{
-    Cosegmentation, GraphError, PartCues, PartsFrom, SegmentCollectionOptions, ShapeNode,
-    StopReason, geometric_part_tree, geometric_part_tree_with_cues, load_or_compute_part_cues,
-    segment_collection,
-};
+use coseg::graph::{Cosegmentation, GraphError, ShapeNode};
 use coseg::mesh::TriMesh;
+use coseg::parts::{
+    PartCues, PartsFrom, SegmentCollectionOptions, StopReason, geometric_part_tree,
+    geometric_part_tree_with_cues, load_or_compute_part_cues, segment_collection,
+};
 
 /// A column of octagonal rings along y, ring `k` at height `0.5 k` with radius `radius(k)`,
 /// capped at both ends (the caps' centres are the last two vertices), plus, when `rod` is
@@ -151,7 +151,7 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
         })
         .collect();
     let mut o = SegmentCollectionOptions::default();
-    o.request_parts(coseg::graph::PartsRequest::Count(2), None);
+    o.request_parts(coseg::parts::PartsRequest::Count(2), None);
     o.set_parts_from("geometry".parse().unwrap(), Some(6));
     // The tree's cut as it is: the boundary snapping is tested on its own.
     o.set_snap_band(0.0).unwrap();
@@ -185,12 +185,12 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
         assert_eq!(cue_entries(dir.path()), 3);
     }
     // A number of parts is needed, and enough regions to make them.
-    o.request_parts(coseg::graph::PartsRequest::Auto, None);
+    o.request_parts(coseg::parts::PartsRequest::Auto, None);
     assert!(matches!(
         segment_collection(nodes.clone(), &meshes, &o),
         Err(GraphError::BadOption(_))
     ));
-    o.request_parts(coseg::graph::PartsRequest::Count(8), None);
+    o.request_parts(coseg::parts::PartsRequest::Count(8), None);
     assert!(matches!(
         segment_collection(nodes.clone(), &meshes, &o),
         Err(GraphError::BadOption(_))

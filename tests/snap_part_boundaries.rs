@@ -1,11 +1,12 @@
-//! Tests of `graph::snap_part_boundaries`: part boundaries moved onto concave creases by a
+//! Tests of `parts::snap_part_boundaries`: part boundaries moved onto concave creases by a
 //! minimum cut in a band.
 
 mod common;
 
 use common::graph::coseg_of;
-use coseg::graph::{Cosegmentation, GraphError, snap_part_boundaries};
+use coseg::graph::{Cosegmentation, GraphError};
 use coseg::mesh::TriMesh;
+use coseg::parts::snap_part_boundaries;
 
 /// A column of 20 octagonal rings 0.25 apart (capped; the caps' centres are vertices 160 and
 /// 161): rings below `step` have radius 1, the others 0.4, and ring `step` lies in the thick

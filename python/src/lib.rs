@@ -6,7 +6,8 @@
 mod options;
 
 use coseg::cache::CacheOutcome;
-use coseg::graph::{SegmentCollectionOptions, ShapeNode, load_collection, segment_collection};
+use coseg::graph::{ShapeNode, load_collection};
+use coseg::parts::{SegmentCollectionOptions, segment_collection};
 use coseg::labels::{LabelKind, PartNames, read_part_names, read_shape_labels};
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
 use coseg::output::{

@@ -7,10 +7,8 @@ use coseg::features::{
     ExtrinsicOptions, FamilyWeights, FeatureError, parse_alignment, parse_families,
     parse_family_weights,
 };
-use coseg::graph::{
-    CosegmentOptions, GraphError, GraphOptions, PartsFrom, PartsRequest, RefineSizes,
-    SegmentCollectionOptions,
-};
+use coseg::graph::{CosegmentOptions, GraphError, GraphOptions, RefineSizes};
+use coseg::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions};
 use coseg::maps::{MapGuidedOptions, MapOverrides, MapPreset, MapStep, ZoomOutOptions};
 use coseg::pipeline::ShapePipelineOptions;
 use coseg::propagate::{MapStepOptions, PropagateOptions};
@@ -358,7 +356,7 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("starts", s.starts)?;
     d.set_item("refine_sizes", "free")?;
     d.set_item("parts_from", "adaptive")?;
-    let a = coseg::graph::AdaptiveOptions::default();
+    let a = coseg::parts::AdaptiveOptions::default();
     d.set_item("max_parts", a.max_parts)?;
     let r = StableRegionsOptions::default();
     d.set_item(

@@ -3,10 +3,10 @@
 use super::{AffinityError, BandAffinity};
 
 /// Largest number of entries [`dense_affinity`] builds (2²⁶ ≈ 67 M, 512 MiB of `f64`).
-pub const DENSE_LIMIT: usize = 1 << 26;
+const DENSE_LIMIT: usize = 1 << 26;
 
 /// The dense affinity, row-major `d_b × d_a`: `w[q * d_a + p] = W_qp`. Only for tests and
-/// small shapes (errors past [`DENSE_LIMIT`] entries); the library never builds it.
+/// small shapes (errors past `DENSE_LIMIT` entries); the library never builds it.
 ///
 /// ```
 /// use coseg::affinity::{dense_affinity, BandAffinity};

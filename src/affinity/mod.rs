@@ -18,7 +18,7 @@ pub(crate) mod kernel;
 pub use band_affinity::{
     AffinityWorkspace, BandAffinity, Direction, FeaturePairing, IndicatorHistogram,
 };
-pub use dense_affinity::{DENSE_LIMIT, dense_affinity};
+pub use dense_affinity::dense_affinity;
 
 use thiserror::Error;
 

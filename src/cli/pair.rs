@@ -2,7 +2,7 @@
 
 use anyhow::{Context, Result};
 use clap::{Args, ValueEnum};
-use coseg::maps::{MapOverrides, MapPreset, MapStep, NEAR_ISOMETRIC_DISCREPANCY, PresetChoice};
+use coseg::maps::{MapOverrides, MapPreset, MapStep, PresetChoice};
 use coseg::mesh::TriMesh;
 use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, write_visuals};
 use coseg::pipeline::{PipelineError, ShapeData, ShapePipelineOptions, load_shape};
@@ -400,13 +400,12 @@ fn report(
 ) {
     if let Some(choice) = map_preset {
         println!(
-            "map step: {} preset (eigenvalue discrepancy {:.4}; near-isometric below {})",
+            "map step: {} preset (eigenvalue discrepancy {:.4})",
             match choice.preset {
                 MapPreset::General => "general",
                 MapPreset::NearIsometric => "near-isometric",
             },
-            choice.discrepancy,
-            NEAR_ISOMETRIC_DISCREPANCY
+            choice.discrepancy
         );
     }
     println!(

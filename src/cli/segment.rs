@@ -4,11 +4,12 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{
-    CosegmentOptions, GraphError, GraphOptions, LoadedCollection, PartsFrom, PartsRequest,
-    RefineSizes, SegmentCollectionOptions, SegmentedCollection, load_collection,
-    segment_collection,
+    CosegmentOptions, GraphError, GraphOptions, LoadedCollection, RefineSizes, load_collection,
 };
 use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
+use coseg::parts::{
+    PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentedCollection, segment_collection,
+};
 use coseg::pipeline::ShapePipelineOptions;
 use coseg::render::{RenderOptions, RenderShape};
 use coseg::stable::RefineOptions;

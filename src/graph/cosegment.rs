@@ -189,7 +189,7 @@ impl Cosegmentation {
 
 /// Per-shape histograms and score tables: the engine of the sweeps (also of
 /// [`super::refine_cosegmentation`], one engine per region).
-pub(super) struct Engine<'g> {
+pub(crate) struct Engine<'g> {
     graph: &'g ShapeGraph,
     bands: usize,
     /// `neighbours[i]`: `(j, edge weight, pairs as (k on j, k on i), raw pair weights)`.
@@ -214,7 +214,7 @@ struct Neighbour {
 }
 
 impl<'g> Engine<'g> {
-    pub(super) fn new(graph: &'g ShapeGraph) -> Self {
+    pub(crate) fn new(graph: &'g ShapeGraph) -> Self {
         let n = graph.node_count();
         let bands = graph.node(0).bands.bands;
         let neighbours = (0..n)
@@ -270,7 +270,7 @@ impl<'g> Engine<'g> {
     /// Makes `region` (strictly ascending) shape `i`'s current region. The histogram is
     /// updated by the vertices that enter or leave (counts are exact integers, so this equals a
     /// rebuild), which in late sweeps are a few boundary vertices.
-    pub(super) fn set_region(&mut self, i: usize, region: &[u32]) {
+    pub(crate) fn set_region(&mut self, i: usize, region: &[u32]) {
         let t = &self.graph.node(i).bands;
         let k = self.bands;
         let h = &mut self.hist[i];
@@ -310,7 +310,7 @@ impl<'g> Engine<'g> {
 
     /// Scores on the remaining vertices of `i` from the current regions of `sources` (all
     /// neighbours when `None`).
-    pub(super) fn scores(
+    pub(crate) fn scores(
         &mut self,
         i: usize,
         sources: Option<&[usize]>,
@@ -566,7 +566,7 @@ fn check(graph: &ShapeGraph, options: &CosegmentOptions) -> Result<(), GraphErro
 }
 
 /// Root and breadth-first spanning tree of the graph.
-pub(super) fn spanning_tree(
+pub(crate) fn spanning_tree(
     graph: &ShapeGraph,
     root: Option<usize>,
 ) -> (usize, Vec<usize>, Vec<Option<usize>>) {
@@ -599,7 +599,7 @@ pub(super) fn spanning_tree(
     (root, order, parent)
 }
 
-pub(super) fn seed_region(
+pub(crate) fn seed_region(
     graph: &ShapeGraph,
     root: usize,
     rem: &[u32],
@@ -643,7 +643,7 @@ pub(super) fn seed_region(
 }
 
 /// The last tuple: the leftover vertices of every shape, with their confidences.
-pub(super) fn leftovers_tuple(
+pub(crate) fn leftovers_tuple(
     graph: &ShapeGraph,
     regions: Vec<Vec<u32>>,
     confidence: f64,
@@ -666,7 +666,7 @@ pub(super) fn leftovers_tuple(
     }
 }
 
-pub(super) fn area(areas: &[f64], v: &[u32]) -> f64 {
+pub(crate) fn area(areas: &[f64], v: &[u32]) -> f64 {
     v.iter().map(|&p| areas[p as usize]).sum()
 }
 
@@ -678,7 +678,7 @@ fn iou(areas: &[f64], a: &[u32], b: &[u32]) -> f64 {
     if u > 0.0 { i / u } else { 1.0 }
 }
 
-pub(super) fn tuple_hash(tuple: &[Vec<u32>]) -> [u8; 32] {
+pub(crate) fn tuple_hash(tuple: &[Vec<u32>]) -> [u8; 32] {
     let mut h = blake3::Hasher::new();
     for r in tuple {
         h.update(&(r.len() as u64).to_le_bytes());
@@ -690,7 +690,7 @@ pub(super) fn tuple_hash(tuple: &[Vec<u32>]) -> [u8; 32] {
 }
 
 /// The triangles `(i < j < k)` of the graph, a deterministic evenly spaced sample of `count`.
-pub(super) fn sample_triangles(graph: &ShapeGraph, count: usize) -> Vec<[usize; 3]> {
+pub(crate) fn sample_triangles(graph: &ShapeGraph, count: usize) -> Vec<[usize; 3]> {
     if count == 0 {
         return Vec::new();
     }
@@ -877,10 +877,10 @@ struct SweepOutcome {
 }
 
 /// The band-affinity operators of the three edges of each sampled triangle, per triangle.
-pub(super) type TriangleOps<'g> = Vec<Vec<(BandAffinity<'g>, crate::affinity::Direction)>>;
+pub(crate) type TriangleOps<'g> = Vec<Vec<(BandAffinity<'g>, crate::affinity::Direction)>>;
 
 /// The band-affinity operators of the three edges of each sampled triangle.
-pub(super) fn triangle_ops<'g>(
+pub(crate) fn triangle_ops<'g>(
     graph: &'g ShapeGraph,
     triangles: &[[usize; 3]],
 ) -> Result<TriangleOps<'g>, GraphError> {
@@ -1008,7 +1008,7 @@ fn sweep_tuple(
 
 /// Tree-edge agreement and triangle cycle consistency of a tuple (the engine's histograms hold
 /// the tuple's regions).
-pub(super) fn confidence(
+pub(crate) fn confidence(
     graph: &ShapeGraph,
     eng: &mut Engine<'_>,
     parent: &[Option<usize>],

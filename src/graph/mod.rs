@@ -1,5 +1,6 @@
 //! Shape collections: the shape graph, the cycle solver and consistent co-segmentation of a
-//! whole collection (docs/METHOD.md §5).
+//! whole collection (docs/METHOD.md §5). What turns the co-segmentation's regions into parts
+//! (parts of their own size, the part trees, mirror pairs) is the next stage, [`crate::parts`].
 //!
 //! - [`stable_cycle`]: fixed points of `P_0 ∘ W_{0,m−1} ∘ … ∘ P_1 ∘ W_10` around a cycle of any
 //!   length `m ≥ 2`; the 2-cycle is exactly Algorithm 1.
@@ -9,63 +10,28 @@
 //!   feature pairing and a weight; pairwise affinities exist only as band-table operators.
 //! - [`cosegment`]: consistent region tuples across every shape of the graph (design argued
 //!   in that function's module).
-//! - [`adaptive_cosegment`]: the same with each tuple's size found from the data
-//!   (Algorithm 3 across the graph), the number of parts from the data and a tree of parts.
-//! - [`mirror_pairs`]: which tuples are left/right copies of each other (each shape's own
-//!   plane of mirror symmetry, [`mirror_plane`]); the part tree merges them first.
-//! - [`geometric_part_tree`]: a part tree over equal-area regions that merges touching regions
-//!   (and mirror pairs) of one thickness (`--parts N --parts-from geometry`), after
-//!   [`split_disconnected_leaves`] has split regions made of pieces of different parts, and
-//!   before [`snap_part_boundaries`] moves the parts' boundaries onto creases.
 //! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
 //!   boundaries over every edge of the graph.
-//! - [`segment_collection`]: graph, co-segmentation and refinement in one call, as
-//!   `coseg segment` runs them.
 //! - [`load_collection`]: a folder of meshes to graph nodes through the per-shape cache.
 
-mod adaptive_cosegment;
 mod cosegment;
 mod cycle_consistency;
-mod geometric_part_tree;
 mod load_collection;
-mod mirror_pairs;
-mod part_cues;
 mod refine_cosegmentation;
-mod segment_collection;
 mod shape_graph;
-mod snap_part_boundaries;
-mod split_disconnected_leaves;
 mod stable_cycle;
 
-pub use adaptive_cosegment::{
-    AdaptiveCosegmentation, AdaptiveOptions, AutoTuple, PartMerge, PartTree, PartsReport, Sizing,
-    StopReason, adaptive_cosegment, adaptive_update,
-};
 pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
-pub use cycle_consistency::{CycleConsistency, cycle_consistency};
-pub use geometric_part_tree::{
-    SIBLING_COST, geometric_part_tree, geometric_part_tree_linked, geometric_part_tree_with_cues,
+pub(crate) use cosegment::{
+    Engine, area, confidence, leftovers_tuple, sample_triangles, seed_region, spanning_tree,
+    triangle_ops, tuple_hash,
 };
+pub use cycle_consistency::{CycleConsistency, cycle_consistency};
 pub use load_collection::{
     LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
 };
-pub use mirror_pairs::{
-    Likeness, MIRROR_AREA_BALANCE, MIRROR_LIKENESS, MIRROR_PAIR_RATIO, MirrorPair, MirrorPlane,
-    mirror_pairs, mirror_plane,
-};
-pub use part_cues::{PartCues, PartCuesResult, load_or_compute_part_cues};
-pub use refine_cosegmentation::{
-    MIN_KEPT_SHARE, RefineSizes, refine_cosegmentation, refine_cosegmentation_sized,
-};
-pub use segment_collection::{
-    PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentTimes, SegmentedCollection,
-    segment_collection, start_score,
-};
+pub use refine_cosegmentation::{RefineSizes, refine_cosegmentation, refine_cosegmentation_sized};
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
-pub use snap_part_boundaries::snap_part_boundaries;
-pub use split_disconnected_leaves::{
-    SPLIT_PIECE_SHARE, SPLIT_SAME_DIRECTION, SplitLeaves, split_disconnected_leaves,
-};
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,
 };
@@ -99,7 +65,8 @@ pub enum GraphError {
         #[source]
         source: crate::spectral::SpectralError,
     },
-    /// A shape's thickness (shape diameter function) for [`geometric_part_tree`] could not be
+    /// A shape's thickness (shape diameter function) for
+    /// [`geometric_part_tree`](crate::parts::geometric_part_tree) could not be
     /// computed.
     #[error("shape {name}: thickness (SDF): {source}")]
     Thickness {

@@ -19,7 +19,7 @@ use serde::{Deserialize, Serialize};
 /// (the edge-weighted mean fraction of features whose bands agree with region `r` of the
 /// neighbour `j`, as in [`cosegment`](super::cosegment)'s scores), heat-smoothed over shape `i`
 /// when `smoothers` is given (one per shape, in graph order). A shape update that would leave
-/// a region below [`MIN_KEPT_SHARE`] of its area before refinement is redone with that floor
+/// a region below `MIN_KEPT_SHARE` of its area before refinement is redone with that floor
 /// (see there). Stops when a whole sweep changes nothing, or after `options.max_rounds` sweeps.
 ///
 /// The result is `coseg` with every tuple's regions replaced by the refined ones (region id
@@ -64,14 +64,14 @@ pub enum RefineSizes {
     /// about inversely proportional to the region's spread in band space: a small region's
     /// score peaks higher, wins the vertices on a shared boundary, and the regions drift
     /// towards equal areas (measured on the shipped families, docs/PARTS.md). One limit: no
-    /// region falls below [`MIN_KEPT_SHARE`] of its area before refinement on any shape (a
+    /// region falls below `MIN_KEPT_SHARE` of its area before refinement on any shape (a
     /// region spread thin would otherwise empty).
     #[default]
     Free,
     /// Size-aware best response: each vertex of shape `i` takes the region maximising
     /// `s_r(q) · exp(θ_ir)`, with one factor per shape and region chosen so that region `r`'s
     /// area on shape `i` stays within a factor `1 + tolerance` of its area before refinement
-    /// (the sizes [`adaptive_cosegment`](super::adaptive_cosegment) read from the data).
+    /// (the sizes [`adaptive_cosegment`](crate::parts::adaptive_cosegment) read from the data).
     /// The factors are the dual variables of that size-constrained assignment, found by exact
     /// coordinate steps (a region outside its band gets the `θ_ir` that puts its area on the
     /// nearest bound, the others held; at most 20 passes over the regions per shape update,
@@ -81,40 +81,6 @@ pub enum RefineSizes {
         /// Allowed relative change of each region's area (`0.25`: within a factor 1.25).
         tolerance: f64,
     },
-}
-
-impl std::str::FromStr for RefineSizes {
-    type Err = GraphError;
-
-    /// `free`, `keep` (tolerance [`AdaptiveOptions::size_tolerance`](super::AdaptiveOptions),
-    /// the sizes' own tolerance) or `keep:TOL` (`TOL` ≥ 0), as `coseg segment --refine-sizes`.
-    ///
-    /// ```
-    /// use coseg::graph::RefineSizes;
-    /// assert_eq!("free".parse::<RefineSizes>().unwrap(), RefineSizes::Free);
-    /// assert_eq!("keep:0.25".parse::<RefineSizes>().unwrap(), RefineSizes::Keep { tolerance: 0.25 });
-    /// assert_eq!("keep".parse::<RefineSizes>().unwrap(), RefineSizes::Keep { tolerance: 0.5 });
-    /// assert!("keep:-1".parse::<RefineSizes>().is_err());
-    /// ```
-    fn from_str(s: &str) -> Result<Self, GraphError> {
-        let bad = || {
-            GraphError::BadOption(format!(
-                "{s:?}: expected `free`, `keep` or `keep:TOL` (TOL ≥ 0)"
-            ))
-        };
-        match s {
-            "free" => Ok(Self::Free),
-            "keep" => Ok(Self::Keep {
-                tolerance: super::AdaptiveOptions::default().size_tolerance,
-            }),
-            _ => match s.strip_prefix("keep:").map(str::parse::<f64>) {
-                Some(Ok(tolerance)) if tolerance.is_finite() && tolerance >= 0.0 => {
-                    Ok(Self::Keep { tolerance })
-                }
-                _ => Err(bad()),
-            },
-        }
-    }
 }
 
 /// [`refine_cosegmentation`] with a size rule ([`RefineSizes`]); `RefineSizes::Free` is
@@ -221,7 +187,7 @@ pub fn refine_cosegmentation_sized(
 }
 
 /// The size-aware assignment of one shape ([`RefineSizes::Keep`], and the free rule's floor
-/// [`MIN_KEPT_SHARE`]): `scores` column-major `d × R` (already smoothed), `areas` per vertex,
+/// `MIN_KEPT_SHARE`): `scores` column-major `d × R` (already smoothed), `areas` per vertex,
 /// `target[r]` = region `r`'s area fraction before refinement, `band` the allowed areas
 /// around it, `theta[r]` the log factors (updated in place, warm start). Each vertex takes
 /// `argmax_r ln s_r(q) + θ_r`; passes over the regions set, for each region whose area is
@@ -347,7 +313,7 @@ fn assign_sized(
 enum Band {
     /// `[target / (1 + τ), target (1 + τ)]` ([`RefineSizes::Keep`]).
     Tolerance(f64),
-    /// `[share · target, ∞)` (the free rule's floor, [`MIN_KEPT_SHARE`]).
+    /// `[share · target, ∞)` (the free rule's floor, `MIN_KEPT_SHARE`).
     Floor(f64),
 }
 
@@ -365,7 +331,7 @@ const SIZE_PASSES: usize = 20;
 /// the boundaries still move where the scores cross, and updates that keep every region above
 /// its floor are the free rule bit for bit. Measured at 0.25 and 0.1: 0.25 lowered 20 FAUST
 /// from 94.1 to 93.5 %, 0.1 raised it to 94.5 % (TOSCA cats and michael unchanged).
-pub const MIN_KEPT_SHARE: f64 = 0.1;
+const MIN_KEPT_SHARE: f64 = 0.1;
 
 /// Area share of each of `regions` regions under `labels` (`areas` sum to 1).
 fn region_shares(labels: &[i32], areas: &[f64], regions: usize) -> Vec<f64> {

@@ -49,13 +49,13 @@ impl Default for MapGuidedOptions {
 }
 
 /// Eigenvalues compared by [`map_preset`] (`λ_1 … λ_19`).
-pub const PRESET_EIGENVALUES: usize = 20;
+const PRESET_EIGENVALUES: usize = 20;
 
 /// The [`eigenvalue_discrepancy`] below which [`map_preset`] treats a pair as near-isometric.
-/// Measured over [`PRESET_EIGENVALUES`]: 0.009–0.023 on the 24 TOSCA within-class pairs,
+/// Measured over `PRESET_EIGENVALUES`: 0.009–0.023 on the 24 TOSCA within-class pairs,
 /// 0.036 and more on the generated quadrupeds (different bodies), 0.05 and more between
 /// TOSCA classes (README).
-pub const NEAR_ISOMETRIC_DISCREPANCY: f64 = 0.03;
+const NEAR_ISOMETRIC_DISCREPANCY: f64 = 0.03;
 
 /// A named set of map-step options.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -81,14 +81,14 @@ impl MapPreset {
 pub struct PresetChoice {
     /// The chosen preset.
     pub preset: MapPreset,
-    /// The pair's [`eigenvalue_discrepancy`] over [`PRESET_EIGENVALUES`] (or fewer, when a
+    /// The pair's [`eigenvalue_discrepancy`] over `PRESET_EIGENVALUES` (or fewer, when a
     /// spectrum is shorter).
     pub discrepancy: f64,
 }
 
 /// Chooses the map step's preset for shapes A and B from their unit-area spectra:
 /// [`MapPreset::NearIsometric`] when their [`eigenvalue_discrepancy`] is below
-/// [`NEAR_ISOMETRIC_DISCREPANCY`], else [`MapPreset::General`].
+/// `NEAR_ISOMETRIC_DISCREPANCY`, else [`MapPreset::General`].
 ///
 /// Why: the near-isometric preset trusts the point map more and matches descriptors
 /// pointwise, which is what two poses of one body reward (TOSCA within-class: 95.7 % against

@@ -16,8 +16,7 @@ pub(crate) mod zoomout;
 pub use auction_assignment::{Assignment, AuctionOptions, CandidateLists, auction_assignment};
 pub use eigenvalue_discrepancy::eigenvalue_discrepancy;
 pub use map_preset::{
-    MapGuidedOptions, MapOverrides, MapPreset, MapStep, NEAR_ISOMETRIC_DISCREPANCY,
-    PRESET_EIGENVALUES, PresetChoice, ResolvedMapStep, map_preset,
+    MapGuidedOptions, MapOverrides, MapPreset, MapStep, PresetChoice, ResolvedMapStep, map_preset,
 };
 pub use nearest_rows::nearest_candidates;
 pub use region_point_map::{MapShape, PointMapOptions, region_point_map};

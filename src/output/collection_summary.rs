@@ -1,6 +1,7 @@
 //! [`CollectionSummary`]: the `summary.json` of a collection co-segmentation.
 
-use crate::graph::{GraphKind, SegmentCollectionOptions, SegmentedCollection};
+use crate::graph::GraphKind;
+use crate::parts::{SegmentCollectionOptions, SegmentedCollection};
 use serde::Serialize;
 
 /// One shape of a collection run.
@@ -96,7 +97,7 @@ pub struct CollectionSummary {
     /// With `--parts`: the adaptive run's thresholds, stop reason, tree and mirror
     /// candidates (absent otherwise).
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub parts: Option<crate::graph::PartsReport>,
+    pub parts: Option<crate::parts::PartsReport>,
     /// With several starts (`--starts N`): the start kept and every start's score (mean tuple
     /// confidence); absent with one start.
     #[serde(skip_serializing_if = "Option::is_none")]
@@ -108,7 +109,7 @@ pub struct CollectionSummary {
 pub struct StartsReport {
     /// Index of the start kept (0 = the default start).
     pub chosen: usize,
-    /// Mean tuple confidence of each start ([`crate::graph::start_score`]).
+    /// Mean tuple confidence of each start ([`crate::parts::start_score`]).
     pub scores: Vec<f64>,
 }
 
@@ -117,7 +118,8 @@ impl CollectionSummary {
     ///
     /// ```
     /// use coseg::bands::equal_count_bands;
-    /// use coseg::graph::{segment_collection, SegmentCollectionOptions, ShapeNode};
+    /// use coseg::graph::{ShapeNode};
+    /// use coseg::parts::{segment_collection, SegmentCollectionOptions};
     /// use coseg::output::CollectionSummary;
     /// let t = equal_count_bands(&[0.0, 1.0, 2.0, 3.0], 1, 4, 4).unwrap();
     /// let nodes: Vec<ShapeNode> =

@@ -100,7 +100,7 @@ impl ShapePipelineOptions {
     /// The up direction in file coordinates (unit) when the extrinsic family is on with an
     /// aligned collection (`--up y`, …); `None` without it or with `--up pca`. What the
     /// mirror-pair test of the collection stage uses
-    /// ([`crate::graph::SegmentCollectionOptions::up`]).
+    /// ([`crate::parts::SegmentCollectionOptions::up`]).
     ///
     /// ```
     /// use coseg::pipeline::ShapePipelineOptions;
@@ -125,7 +125,7 @@ impl ShapePipelineOptions {
     /// The columns of a feature table of `features` columns (made under these options) that a
     /// mirror image leaves unchanged: the spectral descriptors and the shape diameter (`sdf`),
     /// not the extrinsic heights and normals nor the user's columns (unknown). What the
-    /// mirror-pair test compares two parts on ([`crate::graph::Likeness`]).
+    /// mirror-pair test compares two parts on ([`crate::parts::Likeness`]).
     ///
     /// ```
     /// use coseg::pipeline::ShapePipelineOptions;

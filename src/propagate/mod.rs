@@ -27,7 +27,7 @@ pub use collection::{
 };
 pub use map_step::{MapStepOptions, MapStepReport, map_step};
 pub use options::PropagateOptions;
-pub use part_scores::{GEOMETRIC_FLOOR, PartScore};
+pub use part_scores::PartScore;
 pub use solve::{Propagation, UpdateStats, propagate_labels};
 
 use thiserror::Error;

@@ -26,13 +26,13 @@ pub enum PartScore {
     /// The weighted arithmetic mean: the band affinity's mean transport (the paper's score).
     #[default]
     Affinity,
-    /// The weighted geometric mean (`ε` = [`GEOMETRIC_FLOOR`] added to every value).
+    /// The weighted geometric mean (`ε` = `GEOMETRIC_FLOOR` added to every value).
     Geometric,
 }
 
 /// Floor added to every histogram value of the geometric mean, so that one feature where the
 /// part never falls lowers a score without zeroing it.
-pub const GEOMETRIC_FLOOR: f64 = 1e-3;
+const GEOMETRIC_FLOOR: f64 = 1e-3;
 
 /// Scores of every destination vertex of `dir` for every part of the source labels:
 /// column-major `d_dst × parts` (`scores[r · d_dst + q]`). `source_labels[p] ∈ 0..parts` or

@@ -16,7 +16,7 @@
 //! kinds); their weights can stay negative. The tufted cover of Sharp & Crane 2020, which
 //! would also flip around non-manifold edges, is not implemented.
 
-use super::surface_operators::{assemble, halved_within_bound};
+use super::cotangent_weights::{assemble, halved_within_bound};
 use crate::mesh::{TriMesh, norm, sub};
 use faer::sparse::SparseColMat;
 use std::collections::HashMap;
@@ -106,7 +106,7 @@ impl IntrinsicDelaunay {
 
     /// `cot(θ_k) / 2` per corner of the intrinsic triangles (`F × 3`), under the rule of
     /// [`crate::spectral::SurfaceOperators`] (degenerate faces give zeros; one common factor
-    /// when a cotangent exceeds [`MAX_COTANGENT`](crate::spectral::MAX_COTANGENT)).
+    /// when a cotangent exceeds `MAX_COTANGENT`).
     pub fn half_cotangents(&self) -> Vec<[f64; 3]> {
         self.lengths
             .iter()

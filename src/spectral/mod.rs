@@ -11,6 +11,7 @@
 
 mod block_lanczos;
 mod cotan_laplacian;
+mod cotangent_weights;
 mod heat_smoother;
 mod intrinsic_delaunay;
 mod laplace_beltrami_spectrum;
@@ -26,7 +27,7 @@ pub use laplace_beltrami_spectrum::{
     laplace_beltrami_spectrum, laplace_beltrami_spectrum_with_stats,
 };
 pub use lumped_mass::lumped_mass;
-pub use surface_operators::{LaplacianKind, MAX_COTANGENT, SurfaceOperators};
+pub use surface_operators::{LaplacianKind, SurfaceOperators};
 
 use thiserror::Error;
 

@@ -2,15 +2,9 @@
 //! one rule for clamped and degenerate triangles, shared by the spectrum, the heat smoother
 //! and the mean curvature.
 
+use super::cotangent_weights::{assemble, halved_within_bound};
 use crate::mesh::{TriMesh, cross, dot, norm, sub};
-use faer::sparse::{SparseColMat, Triplet};
-
-/// Largest magnitude allowed for a cotangent weight. Nearly degenerate triangles have
-/// unbounded cotangents; when one of a triangle's cotangents exceeds this, all three are scaled
-/// down by the same factor (which keeps `L` positive semi-definite), bounding `L`'s entries at
-/// the price of a local error on those triangles only. Degenerate (zero-area) triangles
-/// contribute nothing.
-pub const MAX_COTANGENT: f64 = 1e5;
+use faer::sparse::SparseColMat;
 
 /// Which triangulation the cotangent Laplacian is built on ([`SurfaceOperators::with_laplacian`],
 /// [`super::SpectrumOptions::laplacian`]).
@@ -54,7 +48,7 @@ impl std::str::FromStr for LaplacianKind {
 /// - `half_cotangents`: `F × 3`, `cot(θ_k) / 2` of the angle at corner `k` of each face (the
 ///   weight of the opposite edge `(k+1, k+2)`), under **the one rule** of this crate: a face
 ///   with a corner of zero, negative or non-finite `|u × v|` is degenerate and gets three
-///   zeros; a face whose largest `|cot|` exceeds [`MAX_COTANGENT`] has all three scaled by the
+///   zeros; a face whose largest `|cot|` exceeds `MAX_COTANGENT` has all three scaled by the
 ///   same factor (keeps each face's stiffness matrix positive semi-definite, whereas clamping
 ///   each cotangent apart can make a needle triangle indefinite);
 /// - `laplacian`: `d × d`, the weak cotangent Laplacian `L` assembled from those weights,
@@ -231,43 +225,4 @@ fn half_cotangents(mesh: &TriMesh) -> Vec<[f64; 3]> {
             halved_within_bound(cot)
         })
         .collect()
-}
-
-/// The rule's last step, shared by every triangulation: `cot / 2` per corner, all three scaled
-/// by one factor when the largest `|cot|` exceeds [`MAX_COTANGENT`] (c₀c₁ + c₁c₂ + c₂c₀ = 1 > 0
-/// survives a common positive factor; a separate clamp per corner does not).
-pub(super) fn halved_within_bound(mut cot: [f64; 3]) -> [f64; 3] {
-    let big = cot.iter().fold(0.0f64, |a, c| a.max(c.abs()));
-    if big > MAX_COTANGENT {
-        let s = MAX_COTANGENT / big;
-        for c in cot.iter_mut() {
-            *c *= s;
-        }
-    }
-    cot.map(|c| 0.5 * c)
-}
-
-/// The `d × d` Laplacian of `faces` with per-corner weights `half_cotangents` (weight of the
-/// edge facing the corner).
-pub(super) fn assemble(
-    d: usize,
-    faces: &[[u32; 3]],
-    half_cotangents: &[[f64; 3]],
-) -> SparseColMat<usize, f64> {
-    let mut triplets = Vec::with_capacity(faces.len() * 12);
-    for (idx, w) in faces.iter().zip(half_cotangents) {
-        if *w == [0.0; 3] {
-            continue;
-        }
-        for (k, &wk) in w.iter().enumerate() {
-            let (a, b) = (idx[(k + 1) % 3] as usize, idx[(k + 2) % 3] as usize);
-            triplets.push(Triplet::new(a, b, -wk));
-            triplets.push(Triplet::new(b, a, -wk));
-            triplets.push(Triplet::new(a, a, wk));
-            triplets.push(Triplet::new(b, b, wk));
-        }
-    }
-    // Duplicate entries are summed by the constructor.
-    SparseColMat::try_new_from_triplets(d, d, &triplets)
-        .expect("indices are in range by TriMesh's invariants")
 }

@@ -1,8 +1,9 @@
 //! Fixtures for the shape-graph tests: structured band tables and vertex permutations.
 
 use coseg::bands::{BandTable, equal_count_bands};
-use coseg::graph::{Cosegmentation, PartCues, RegionTuple};
+use coseg::graph::{Cosegmentation, RegionTuple};
 use coseg::mesh::TriMesh;
+use coseg::parts::PartCues;
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 

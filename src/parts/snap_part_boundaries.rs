@@ -9,7 +9,7 @@
 //! Where two parts meet, the surface folds inwards (the minima rule), so among the closed
 //! cuts near a boundary the one running along concave edges is the likeliest part boundary.
 
-use super::{Cosegmentation, GraphError};
+use crate::graph::{Cosegmentation, GraphError};
 use crate::mesh::{TriMesh, dot, edge_adjacency, norm, sub};
 use rayon::prelude::*;
 use std::cmp::Ordering;
@@ -55,7 +55,8 @@ const STAY: f64 = 0.05;
 /// band attracts the cut as well; the band keeps such a cut close to where it was.
 ///
 /// ```
-/// use coseg::graph::{snap_part_boundaries, Cosegmentation, RegionTuple};
+/// use coseg::graph::{Cosegmentation, RegionTuple};
+/// use coseg::parts::{snap_part_boundaries};
 /// use coseg::mesh::TriMesh;
 /// // A column of octagonal rings: radius 1 for rings 0–7, 0.4 above; ring 8 lies in the
 /// // thick part's top face (a washer from ring 7), so the surface folds inwards at ring 8,

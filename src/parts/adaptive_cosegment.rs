@@ -3,9 +3,9 @@
 //! data, and a coarse-to-fine tree of the parts found.
 //!
 //! # Tuples of their own size
-//! [`cosegment`](super::cosegment) cuts every region at the same area `α` (Algorithm 2's fixed
+//! [`cosegment`](crate::graph::cosegment) cuts every region at the same area `α` (Algorithm 2's fixed
 //! cutoff). Here each tuple is found as Algorithm 3 finds a pair, with the graph update of
-//! [`cosegment`](super::cosegment) (`f_i = P_i(Σ_j w_ij W_ij f_j / (N_ij |f_j|))`, Gauss–Seidel
+//! [`cosegment`](crate::graph::cosegment) (`f_i = P_i(Σ_j w_ij W_ij f_j / (N_ij |f_j|))`, Gauss–Seidel
 //! sweeps in the spanning tree's breadth-first order until a sweep changes nothing):
 //! 1. **Threshold search.** With `P_i = P[τ_t]` on every shape (vertices scoring at least
 //!    `μ + t σ` of the remaining vertices' scores), find the largest `t ∈ {0, δt, 2δt, …, t_max}`
@@ -25,9 +25,9 @@
 //!
 //! # How many parts
 //! Tuples are extracted one after another on what remains, as in
-//! [`cosegment`](super::cosegment). The extraction stops ([`StopReason`]) before a tuple that
+//! [`cosegment`](crate::graph::cosegment). The extraction stops ([`StopReason`]) before a tuple that
 //! is not stable (step 1 fails at `t = 0`, or step 2 empties a shape), not consistent (its
-//! [`confidence`](super::RegionTuple::confidence) below [`AdaptiveOptions::min_confidence`],
+//! [`confidence`](crate::graph::RegionTuple::confidence) below [`AdaptiveOptions::min_confidence`],
 //! default 0.5, or its triangle cycle consistency below
 //! [`AdaptiveOptions::min_cycle_consistency`], default 0.5 — an IoU of one half means the
 //! region carried by a neighbour, or around a triangle, overlaps itself more than it misses),
@@ -53,12 +53,10 @@
 //! with any number of parts from one run. Ties are broken by the lowest part indices, so the
 //! tree is deterministic.
 
-use super::cosegment::{
-    Engine, area, confidence, leftovers_tuple, sample_triangles, seed_region, spanning_tree,
-    triangle_ops, tuple_hash,
+use crate::graph::{
+    Cosegmentation, Engine, GraphError, RegionTuple, ShapeGraph, area, confidence, leftovers_tuple,
+    sample_triangles, seed_region, spanning_tree, triangle_ops, tuple_hash,
 };
-use super::shape_graph::ShapeGraph;
-use super::{Cosegmentation, GraphError, RegionTuple};
 use crate::stable::{Threshold, ThresholdScratch, threshold};
 use crate::vertex_sets::remove_sorted;
 use serde::{Deserialize, Serialize};
@@ -90,9 +88,9 @@ pub struct AdaptiveOptions {
     pub min_separation: f64,
     /// Smallest median area of a part, as a fraction of its shape (default 0.02).
     pub min_area: f64,
-    /// Root of the spanning tree (default `None`: as [`super::CosegmentOptions::root`]).
+    /// Root of the spanning tree (default `None`: as [`crate::graph::CosegmentOptions::root`]).
     pub root: Option<usize>,
-    /// Start of each tuple (default `None`: as [`super::CosegmentOptions::seed`]).
+    /// Start of each tuple (default `None`: as [`crate::graph::CosegmentOptions::seed`]).
     pub seed: Option<u64>,
     /// Sweep cap of each settling run (default 100).
     pub max_sweeps: usize,
@@ -246,7 +244,7 @@ impl PartTree {
     /// `1..=leaves`): groups of leaf indices, each ascending, ordered by their first leaf.
     ///
     /// ```
-    /// use coseg::graph::{PartMerge, PartTree};
+    /// use coseg::parts::{PartMerge, PartTree};
     /// let t = PartTree { leaves: 3, merges: vec![
     ///     PartMerge { a: 0, b: 2, similarity: 0.9 },
     ///     PartMerge { a: 3, b: 1, similarity: 0.5 },
@@ -315,7 +313,8 @@ impl AdaptiveCosegmentation {
     ///
     /// ```
     /// use coseg::bands::equal_count_bands;
-    /// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, ShapeGraph, ShapeNode};
+    /// use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
+    /// use coseg::parts::{adaptive_cosegment, AdaptiveOptions};
     /// let vals: Vec<f64> = (0..40).map(|v| ((v * 7) % 40) as f64).collect();
     /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
     /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
@@ -354,7 +353,8 @@ impl AdaptiveCosegmentation {
     ///
     /// ```
     /// use coseg::bands::equal_count_bands;
-    /// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, ShapeGraph, ShapeNode};
+    /// use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
+    /// use coseg::parts::{adaptive_cosegment, AdaptiveOptions};
     /// let vals: Vec<f64> = (0..40).map(|v| ((v * 7) % 40) as f64).collect();
     /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
     /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
@@ -561,7 +561,8 @@ impl<'g> Sweeper<'g> {
 ///
 /// ```
 /// use coseg::bands::equal_count_bands;
-/// use coseg::graph::{adaptive_cosegment, adaptive_update, AdaptiveOptions, GraphOptions, ShapeGraph, ShapeNode};
+/// use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
+/// use coseg::parts::{adaptive_cosegment, adaptive_update, AdaptiveOptions};
 /// let vals: Vec<f64> = (0..40).map(|v| ((v * 7) % 40) as f64).collect();
 /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
 /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
@@ -713,7 +714,8 @@ fn search_threshold(
 ///
 /// ```
 /// use coseg::bands::equal_count_bands;
-/// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, ShapeGraph, ShapeNode};
+/// use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
+/// use coseg::parts::{adaptive_cosegment, AdaptiveOptions};
 /// let vals: Vec<f64> = (0..40).map(|v| ((v * 7) % 40) as f64).collect();
 /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
 /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
@@ -1117,166 +1119,4 @@ fn part_tree(sw: &mut Sweeper<'_>, coseg: &Cosegmentation, first: &[(usize, usiz
         });
     }
     PartTree { leaves: l, merges }
-}
-
-/// What `summary.json` records of an adaptive run (`coseg segment --parts`): the finest
-/// parts' thresholds and sizes, why the extraction stopped, the tree, and which final parts
-/// hold several separate pieces (mirror candidates).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct PartsReport {
-    /// Why the extraction stopped.
-    pub stop: StopReason,
-    /// Per leaf (the finest parts, leftovers last): the median area fraction over shapes.
-    pub leaf_areas: Vec<f64>,
-    /// Per extracted leaf: threshold, per-shape sizes, separation.
-    pub auto: Vec<AutoTuple>,
-    /// The merge tree over the leaves.
-    pub tree: PartTree,
-    /// With parts from geometry: the equal-area region (of `--regions`) each leaf comes from,
-    /// when some region was split into its pieces ([`AdaptiveCosegmentation::leaf_origin`]);
-    /// omitted otherwise.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub leaf_origin: Vec<usize>,
-    /// The pairs of those leaves that are copies of one part facing the same way
-    /// ([`AdaptiveCosegmentation::leaf_copies`]); omitted when none.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub leaf_copies: Vec<(usize, usize)>,
-    /// Per final region id: the leaves it is made of.
-    pub region_leaves: Vec<Vec<usize>>,
-    /// Per final region id: the median over shapes of its connected pieces holding at least
-    /// 10 % of its area (`None` without meshes).
-    pub pieces: Option<Vec<usize>>,
-    /// Final region ids with two or more such pieces on most shapes: left/right (or other)
-    /// copies of a part that intrinsic features cannot tell apart. With an extrinsic feature
-    /// family (`--features spectral,extrinsic --up AXIS`, an aligned collection) heights along
-    /// tilted directions tell the copies apart, and they can become parts of their own.
-    pub mirror_candidates: Vec<usize>,
-    /// Pairs of final region ids that are left/right copies of one part
-    /// ([`super::mirror_pairs`]; empty without meshes): what an extrinsic family splits.
-    pub mirror_pairs: Vec<super::MirrorPair>,
-}
-
-impl PartsReport {
-    /// A warning for the user when the parts say little: one part for the whole collection
-    /// because no tuple passed the levels (nothing was split), with the reason. `None`
-    /// otherwise, also when one part is all the upper bound allowed (`--regions 1`).
-    ///
-    /// ```
-    /// use coseg::bands::equal_count_bands;
-    /// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, PartsReport, ShapeGraph, ShapeNode};
-    /// let vals: Vec<f64> = (0..40).map(|v| ((v * 7) % 40) as f64).collect();
-    /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
-    /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
-    /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
-    /// // A separation level of 1 (a perfect split), which this data does not reach: the first
-    /// // tuple is rejected and one part remains.
-    /// let mut o = AdaptiveOptions::default();
-    /// o.min_separation = 1.0;
-    /// let a = adaptive_cosegment(&g, &o).unwrap();
-    /// let r = PartsReport::new(&a, &a.leaves, &[], None, None);
-    /// assert_eq!(r.leaf_areas.len(), 1);
-    /// assert!(r.warning().unwrap().contains("one part for the whole collection"));
-    /// // One part because the upper bound allowed one: nothing to warn about.
-    /// let mut one = AdaptiveOptions::default();
-    /// one.max_parts = 1;
-    /// let a = adaptive_cosegment(&g, &one).unwrap();
-    /// assert_eq!(PartsReport::new(&a, &a.leaves, &[], None, None).warning(), None);
-    /// ```
-    pub fn warning(&self) -> Option<String> {
-        let asked = matches!(
-            self.stop,
-            StopReason::MaxParts | StopReason::EqualAreaLeaves
-        );
-        (self.leaf_areas.len() == 1 && !asked).then(|| {
-            format!(
-                "parts of their own size: one part for the whole collection, since {}; \
-                 ask for a number of parts (--parts N) or try other features (docs/PARTS.md)",
-                self.stop
-            )
-        })
-    }
-
-    /// The report of `adaptive` whose final segmentation (after the cut, and refinement if
-    /// any) is `fin`; `meshes` (graph order, may be empty) give the pieces and the mirror
-    /// pairs, `up` (the aligned collection's up direction, if any) the mirror test's planes,
-    /// `likeness` what mirror pairs must look alike on ([`super::mirror_pairs`]).
-    ///
-    /// ```
-    /// use coseg::bands::equal_count_bands;
-    /// use coseg::graph::{adaptive_cosegment, AdaptiveOptions, GraphOptions, PartsReport, ShapeGraph, ShapeNode};
-    /// let vals: Vec<f64> = (0..40).map(|v| ((v * 7) % 40) as f64).collect();
-    /// let t = equal_count_bands(&vals, 1, 40, 4).unwrap();
-    /// let nodes = (0..3).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 40]).unwrap()).collect();
-    /// let g = ShapeGraph::build(nodes, &GraphOptions::default()).unwrap();
-    /// let a = adaptive_cosegment(&g, &AdaptiveOptions::default()).unwrap();
-    /// let r = PartsReport::new(&a, &a.leaves, &[], None, None);
-    /// assert_eq!(r.region_leaves.len(), a.leaves.tuples.len());
-    /// assert!(r.pieces.is_none() && r.mirror_pairs.is_empty());
-    /// ```
-    pub fn new(
-        adaptive: &AdaptiveCosegmentation,
-        fin: &Cosegmentation,
-        meshes: &[crate::mesh::TriMesh],
-        up: Option<[f64; 3]>,
-        likeness: Option<super::Likeness<'_>>,
-    ) -> Self {
-        let mut region_leaves = adaptive.tree.cut(fin.tuples.len());
-        let leftover_leaf = adaptive.leaves.tuples.len().saturating_sub(1);
-        if let Some(p) = region_leaves
-            .iter()
-            .position(|g| g.contains(&leftover_leaf))
-        {
-            let g = region_leaves.remove(p);
-            region_leaves.push(g);
-        }
-        let pieces = fin.matches(meshes).then(|| {
-            (0..fin.tuples.len())
-                .map(|r| {
-                    let counts: Vec<f64> = meshes
-                        .iter()
-                        .enumerate()
-                        .map(|(i, m)| region_pieces(m, &fin.labels(i), r as i32) as f64)
-                        .collect();
-                    median(&counts) as usize
-                })
-                .collect::<Vec<_>>()
-        });
-        let mirror_candidates = pieces
-            .as_ref()
-            .map(|p| (0..p.len()).filter(|&r| p[r] >= 2).collect())
-            .unwrap_or_default();
-        Self {
-            stop: adaptive.stop,
-            leaf_areas: adaptive
-                .leaves
-                .tuples
-                .iter()
-                .map(|t| median(&t.area_fractions))
-                .collect(),
-            auto: adaptive.auto.clone(),
-            tree: adaptive.tree.clone(),
-            leaf_origin: adaptive.leaf_origin.clone(),
-            leaf_copies: adaptive.leaf_copies.clone(),
-            region_leaves,
-            pieces,
-            mirror_candidates,
-            mirror_pairs: super::mirror_pairs(meshes, fin, up, likeness),
-        }
-    }
-}
-
-/// Connected pieces (through mesh edges) of the vertices labelled `r`, counting those with at
-/// least 10 % of the region's area.
-fn region_pieces(mesh: &crate::mesh::TriMesh, labels: &[i32], r: i32) -> usize {
-    let comps = crate::mesh::labelled_components(mesh, labels);
-    let areas = mesh.vertex_areas();
-    let mut piece = std::collections::BTreeMap::<u32, f64>::new();
-    let mut total = 0.0;
-    for v in 0..labels.len() {
-        if labels[v] == r {
-            *piece.entry(comps.labels[v]).or_default() += areas[v];
-            total += areas[v];
-        }
-    }
-    piece.values().filter(|&&a| a >= 0.1 * total).count()
 }

@@ -20,17 +20,17 @@
 //! places do not (a leg's tip faces down, the tail's tip backwards). Siblings whose pieces'
 //! mean normals agree ([`SplitLeaves::alike`]) are linked in the part tree like mirror pairs;
 //! the others may merge without touching only at an extra cost
-//! ([`super::SIBLING_COST`]), so that alike pieces of different parts (a hand resting on a
+//! (`SIBLING_COST`), so that alike pieces of different parts (a hand resting on a
 //! thigh) stay apart unless nothing cheaper is left.
 
-use super::{Cosegmentation, GraphError};
+use crate::graph::{Cosegmentation, GraphError};
 use crate::mesh::{TriMesh, dot, for_each_label_boundary, labelled_components, norm};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 /// The least share of its region's area (on one shape) a piece kind must hold to count,
 /// in `(0, 1)`: below it a piece is a fragment of the refinement, not a part.
-pub const SPLIT_PIECE_SHARE: f64 = 0.15;
+const SPLIT_PIECE_SHARE: f64 = 0.15;
 
 /// Two kinds split from one region are *alike* ([`SplitLeaves::alike`]) when the (upper)
 /// median, over the shapes where both have pieces, of the angle between their pieces'
@@ -40,7 +40,7 @@ pub const SPLIT_PIECE_SHARE: f64 = 0.15;
 /// more on the generated quadrupeds and humanoids); 35° is the middle of that gap, and every
 /// level tried from 30° to 60° gives the same sets meeting the bar (docs/PARTS.md, "Copies
 /// and look-alikes").
-pub const SPLIT_SAME_DIRECTION: f64 = 35.0;
+const SPLIT_SAME_DIRECTION: f64 = 35.0;
 
 /// `coseg`'s tuples with each disconnected tuple split by the kind of its pieces (module
 /// docs).
@@ -49,7 +49,7 @@ pub const SPLIT_SAME_DIRECTION: f64 = 35.0;
 /// them) and `coseg` (#T tuples). On each shape, every connected piece of a region (vertices
 /// joined by mesh edges within the region) gets as key the other region it shares the most
 /// boundary length with (ties: the lowest id; pieces bordering nothing, whole components of the mesh, share one key). A key
-/// *counts* on a shape when its pieces hold at least [`SPLIT_PIECE_SHARE`] of the region's
+/// *counts* on a shape when its pieces hold at least `SPLIT_PIECE_SHARE` of the region's
 /// area there. A tuple splits when at least two keys count on at least half of the shapes
 /// each, and two or more of those keys count together on at least half of the shapes; it then
 /// becomes one tuple per such key, each shape's pieces going to their key's tuple (pieces of
@@ -75,7 +75,8 @@ pub const SPLIT_SAME_DIRECTION: f64 = 35.0;
 /// See also: [`super::geometric_part_tree_linked`], [`crate::mesh::labelled_components`].
 ///
 /// ```
-/// use coseg::graph::{split_disconnected_leaves, Cosegmentation, RegionTuple};
+/// use coseg::graph::{Cosegmentation, RegionTuple};
+/// use coseg::parts::{split_disconnected_leaves};
 /// use coseg::mesh::TriMesh;
 /// // A strip of 8 vertices in two rows: columns 0..4 left to right. Region 0 is both end
 /// // columns (two pieces, one bordering region 1, the other region 2); regions 1 and 2 the
@@ -236,7 +237,7 @@ pub fn split_disconnected_leaves(
 
 /// Whether the pieces of keys `a` and `b` of region `r` face the same way: the upper median,
 /// over the shapes where both have pieces with a mean normal, of the angle between their
-/// mean normals is below [`SPLIT_SAME_DIRECTION`].
+/// mean normals is below `SPLIT_SAME_DIRECTION`.
 fn face_alike(shapes: &[ShapePieces], r: usize, a: usize, b: usize) -> bool {
     let mut angles: Vec<f64> = shapes
         .iter()
@@ -266,7 +267,7 @@ pub struct SplitLeaves {
     /// For each of them, the input tuple it comes from (`origin[t] = t` for the first #T).
     pub origin: Vec<usize>,
     /// The sibling pairs `(a, b)`, `a < b`, in order, whose pieces face the same way
-    /// ([`SPLIT_SAME_DIRECTION`]): copies of one part side by side (a chair's front and back
+    /// (`SPLIT_SAME_DIRECTION`): copies of one part side by side (a chair's front and back
     /// feet), which the part tree links like mirror pairs; the other siblings are look-alikes
     /// of different parts until shown otherwise.
     pub alike: Vec<(usize, usize)>,
@@ -276,7 +277,8 @@ impl SplitLeaves {
     /// The sibling pairs `(a, b)`, `a < b`: tuples split from one input tuple, in order.
     ///
     /// ```
-    /// use coseg::graph::{Cosegmentation, SplitLeaves};
+    /// use coseg::graph::{Cosegmentation};
+    /// use coseg::parts::{SplitLeaves};
     /// let segmentation = Cosegmentation { names: vec![], vertices: vec![], root: 0,
     ///     order: vec![], parent: vec![], alpha: 0.0, tuples: vec![] };
     /// let s = SplitLeaves { segmentation, origin: vec![0, 1, 2, 0, 0, 2], alike: vec![] };

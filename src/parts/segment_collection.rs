@@ -1,14 +1,18 @@
 //! [`segment_collection`]: the whole collection stage in one call (shape graph →
 //! [`cosegment`] → heat smoothers → [`refine_cosegmentation`]), as `coseg segment` runs it.
 
+use super::adaptive_cosegment::{
+    AdaptiveCosegmentation, AdaptiveOptions, StopReason, adaptive_cosegment,
+};
+use super::geometric_part_tree::geometric_part_tree_linked;
+use super::mirror_pairs::{Likeness, mirror_pairs};
 use super::part_cues::collection_cues;
-use super::shape_graph::{GraphOptions, ShapeGraph, ShapeNode};
-use super::snap_part_boundaries::check_band;
-use super::{
-    AdaptiveCosegmentation, AdaptiveOptions, CosegmentOptions, Cosegmentation, GraphError,
-    Likeness, PartsReport, RefineSizes, StopReason, adaptive_cosegment, cosegment,
-    geometric_part_tree_linked, mirror_pairs, refine_cosegmentation_sized, snap_part_boundaries,
-    split_disconnected_leaves,
+use super::parts_report::PartsReport;
+use super::snap_part_boundaries::{check_band, snap_part_boundaries};
+use super::split_disconnected_leaves::split_disconnected_leaves;
+use crate::graph::{
+    CosegmentOptions, Cosegmentation, GraphError, GraphOptions, RefineSizes, ShapeGraph, ShapeNode,
+    cosegment, refine_cosegmentation_sized,
 };
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -137,7 +141,7 @@ impl std::str::FromStr for PartsFrom {
     /// [`PartsFrom::GEOMETRY_BAND`]).
     ///
     /// ```
-    /// use coseg::graph::PartsFrom;
+    /// use coseg::parts::PartsFrom;
     /// assert_eq!("geometry".parse::<PartsFrom>().unwrap(), PartsFrom::Geometry { leaves: 12, band: 0.1 });
     /// assert!("size".parse::<PartsFrom>().is_err());
     /// ```
@@ -151,6 +155,42 @@ impl std::str::FromStr for PartsFrom {
             _ => Err(GraphError::BadOption(format!(
                 "{s:?}: expected `adaptive` or `geometry`"
             ))),
+        }
+    }
+}
+
+// Here rather than beside `RefineSizes`: `keep` takes the tolerance of parts of their own
+// size, a later stage than the refinement.
+impl std::str::FromStr for RefineSizes {
+    type Err = GraphError;
+
+    /// `free`, `keep` (tolerance [`AdaptiveOptions::size_tolerance`],
+    /// the sizes' own tolerance) or `keep:TOL` (`TOL` ≥ 0), as `coseg segment --refine-sizes`.
+    ///
+    /// ```
+    /// use coseg::graph::RefineSizes;
+    /// assert_eq!("free".parse::<RefineSizes>().unwrap(), RefineSizes::Free);
+    /// assert_eq!("keep:0.25".parse::<RefineSizes>().unwrap(), RefineSizes::Keep { tolerance: 0.25 });
+    /// assert_eq!("keep".parse::<RefineSizes>().unwrap(), RefineSizes::Keep { tolerance: 0.5 });
+    /// assert!("keep:-1".parse::<RefineSizes>().is_err());
+    /// ```
+    fn from_str(s: &str) -> Result<Self, GraphError> {
+        let bad = || {
+            GraphError::BadOption(format!(
+                "{s:?}: expected `free`, `keep` or `keep:TOL` (TOL ≥ 0)"
+            ))
+        };
+        match s {
+            "free" => Ok(Self::Free),
+            "keep" => Ok(Self::Keep {
+                tolerance: AdaptiveOptions::default().size_tolerance,
+            }),
+            _ => match s.strip_prefix("keep:").map(str::parse::<f64>) {
+                Some(Ok(tolerance)) if tolerance.is_finite() && tolerance >= 0.0 => {
+                    Ok(Self::Keep { tolerance })
+                }
+                _ => Err(bad()),
+            },
         }
     }
 }
@@ -178,7 +218,7 @@ impl SegmentCollectionOptions {
 /// How many parts of their own size to ask for (`coseg segment --parts auto|N`).
 ///
 /// ```
-/// use coseg::graph::PartsRequest;
+/// use coseg::parts::PartsRequest;
 /// assert_eq!("auto".parse::<PartsRequest>().unwrap(), PartsRequest::Auto);
 /// assert_eq!("4".parse::<PartsRequest>().unwrap(), PartsRequest::Count(4));
 /// assert!("0".parse::<PartsRequest>().is_err());
@@ -214,7 +254,7 @@ impl SegmentCollectionOptions {
     /// requested count above it), and each tuple started as [`CosegmentOptions::seed`] says.
     ///
     /// ```
-    /// use coseg::graph::{PartsRequest, SegmentCollectionOptions};
+    /// use coseg::parts::{PartsRequest, SegmentCollectionOptions};
     /// let mut o = SegmentCollectionOptions::default();
     /// o.request_parts(PartsRequest::Count(10), None);
     /// let p = o.parts.unwrap();
@@ -241,7 +281,7 @@ impl SegmentCollectionOptions {
     /// number of leaves of [`PartsFrom::Geometry`].
     ///
     /// ```
-    /// use coseg::graph::{PartsFrom, SegmentCollectionOptions};
+    /// use coseg::parts::{PartsFrom, SegmentCollectionOptions};
     /// let mut o = SegmentCollectionOptions::default();
     /// o.set_parts_from("geometry".parse().unwrap(), Some(16));
     /// assert_eq!(o.parts_from, PartsFrom::Geometry { leaves: 16, band: 0.1 });
@@ -263,7 +303,7 @@ impl SegmentCollectionOptions {
     /// is negative or not finite.
     ///
     /// ```
-    /// use coseg::graph::{PartsFrom, SegmentCollectionOptions};
+    /// use coseg::parts::{PartsFrom, SegmentCollectionOptions};
     /// let mut o = SegmentCollectionOptions::default();
     /// assert!(o.set_snap_band(0.1).is_err()); // adaptive parts have no band
     /// o.set_parts_from("geometry".parse().unwrap(), None);
@@ -313,7 +353,7 @@ pub struct SegmentTimes {
     pub cosegment: Duration,
     /// Factorising the heat smoothers (one per shape, in parallel).
     pub smoothers: Duration,
-    /// [`refine_cosegmentation`](super::refine_cosegmentation).
+    /// [`refine_cosegmentation`](crate::graph::refine_cosegmentation).
     pub refine: Duration,
     /// Reading or computing the [`super::PartCues`] (`None`: not needed, only
     /// [`PartsFrom::Geometry`] reads them).
@@ -392,14 +432,15 @@ fn mirror_links(
 
 /// Co-segments a collection: builds the shape graph over `nodes`, extracts consistent region
 /// tuples with [`cosegment`], and (by default) refines their boundaries with
-/// [`refine_cosegmentation`](super::refine_cosegmentation), heat-smoothing on each shape's `meshes[i]` (same order as
+/// [`refine_cosegmentation`](crate::graph::refine_cosegmentation), heat-smoothing on each shape's `meshes[i]` (same order as
 /// `nodes`; only needed when refining with a positive smoothing time).
 ///
 /// Deterministic: the same nodes and options give the same segmentation, bit for bit.
 ///
 /// ```
 /// use coseg::bands::equal_count_bands;
-/// use coseg::graph::{segment_collection, SegmentCollectionOptions, ShapeNode};
+/// use coseg::graph::{ShapeNode};
+/// use coseg::parts::{segment_collection, SegmentCollectionOptions};
 /// use coseg::mesh::TriMesh;
 /// // Three identical 4-vertex shapes (a tetrahedron) with one feature in 4 bands.
 /// let mesh = TriMesh::new(

