@@ -24,6 +24,7 @@
 //! | propagation | [`propagate`] | part labels carried from annotated shapes to a collection |
 //! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view, the palette) |
 //! | output | [`output`] | region files, coloured meshes, summaries, feature export, the viewer page |
+//! | studio | [`studio`] | a labelling session: crease patches, palette, edits with undo, incremental propagation, save (what `coseg studio` serves) |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | scores against ground truth: accuracy, per-part IoU, Rand index, purity and coverage; whole result folders ([`evaluate::evaluate_folder`]) |
 //! | per-shape task | [`shape_task`] | the per-shape stage as bytes in, cache entry bytes out (for distributed engines) |
@@ -48,6 +49,7 @@ pub mod render;
 pub mod shape_task;
 pub mod spectral;
 pub mod stable;
+pub mod studio;
 mod vertex_sets;
 
 /// The README's Rust example, compiled as a doc test so that it cannot rot.

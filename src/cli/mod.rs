@@ -12,6 +12,7 @@ mod propagate;
 mod render;
 mod segment;
 mod spectrum;
+mod studio;
 
 use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -113,6 +114,12 @@ enum Command {
         out/<name>.labels.{txt,ply}, <name>.seg, summary.json."
     )]
     Propagate(propagate::PropagateArgs),
+    /// Label a folder of meshes in the browser: click patches, propagate, correct, save.
+    #[command(after_help = "Example:\n  coseg studio shapes/ --open\n\
+        Serves a page on 127.0.0.1 only; the printed address carries the session's token. \
+        Saves <stem>.labels.txt, <stem>.seg, parts.json and summary.json into --labels \
+        (default FOLDER/labels), and reopening the folder resumes from them.")]
+    Studio(studio::StudioArgs),
 }
 
 static GLOBAL: OnceLock<GlobalArgs> = OnceLock::new();
@@ -194,6 +201,7 @@ pub fn run(cli: Cli) -> anyhow::Result<ExitCode> {
         Command::Render(args) => render::run(args),
         Command::Eval(args) => eval::run(args),
         Command::Propagate(args) => propagate::run(args),
+        Command::Studio(args) => studio::run(args),
     }
 }
 
