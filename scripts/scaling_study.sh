@@ -41,7 +41,7 @@ timed() {
 
 # The generated shapes: 200 quadrupeds (seed 1, the shipped collections' seed).
 shapes=$OUT/quadrupeds
-if [ ! -f "$shapes/quadrupeds_199.obj" ]; then
+if [ ! -f "$shapes/quadrupeds_199.obj" ] || [ ! -f "$shapes/quadrupeds_041.obj" ]; then
   $coseg generate quadrupeds -o "$shapes" --count 200 --threads 1 -q
 fi
 
@@ -65,7 +65,7 @@ for s in "${sections[@]}"; do
       d=$OUT/pair/n$n
       mkdir -p "$d"
       for i in 41 181; do
-        [ -f "$d/q$i.obj" ] || $study refine "$shapes/quadrupeds_$i.obj" "$n" "$d/q$i.obj" >/dev/null
+        [ -f "$d/q$i.obj" ] || $study refine "$shapes/quadrupeds_$(printf %03d "$i").obj" "$n" "$d/q$i.obj" >/dev/null
       done
       va=$(grep -c '^v ' "$d/q41.obj")
       vb=$(grep -c '^v ' "$d/q181.obj")

@@ -9,7 +9,9 @@
 
 mod common;
 
-use common::adversarial::{Case, base_sphere, corpus, with_surface_debris, write_case};
+use common::adversarial::{
+    Case, base_sphere, corpus, with_collinear_slivers, with_surface_debris, write_case,
+};
 use common::generate::collections_dir;
 use coseg::mesh::{TriMesh, read_mesh, write_mesh};
 use std::path::{Path, PathBuf};
@@ -847,4 +849,66 @@ fn propagate_refuses_bad_label_files_naming_them() {
         stderr.contains(&stray.display().to_string()) && stderr.contains("matches a mesh"),
         "{stderr}"
     );
+}
+
+/// Regression (#42): a mesh with 20 triangles collinear up to rounding ("zero-area" in the
+/// file, not exactly in floating point) and duplicated triangles was dropped from every
+/// collection: `eigensolver failed: Cholesky of L − σM (σ = −10): NonPositivePivot`, because
+/// the noise cotangents of those triangles made `L` indefinite. Now the Laplacian treats them
+/// as zero-area, with a warning naming the file, and the shape runs through the default
+/// `coseg segment` and `coseg propagate` (a shipped humanoid's labels onto it).
+#[test]
+fn cholesky_failing_on_collinear_slivers_no_longer_drops_the_shape() {
+    let dir = scratch("collinear_slivers");
+    let shapes = dir.join("shapes");
+    std::fs::create_dir_all(&shapes).unwrap();
+    let humanoids = collections_dir().join("humanoids");
+    for i in 0..2 {
+        let name = format!("humanoids_0{i}.obj");
+        std::fs::copy(humanoids.join(&name), shapes.join(&name)).unwrap();
+    }
+    let base = read_mesh(humanoids.join("humanoids_03.obj")).unwrap();
+    let (p, f) = with_collinear_slivers((base.positions().to_vec(), base.faces().to_vec()), 20);
+    let sliver = shapes.join("slivers.off");
+    write_mesh(&sliver, &TriMesh::new(p, f).unwrap(), &[]).unwrap();
+    let warned = |stderr: &str| {
+        stderr.lines().any(|l| {
+            l.contains("slivers.off") && l.contains("20 triangles are collinear up to rounding")
+        })
+    };
+
+    let out = dir.join("segment");
+    let o = coseg(&[
+        "segment".as_ref(),
+        shapes.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+        "--no-pictures".as_ref(),
+    ]);
+    let (_, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(warned(&stderr), "{stderr}");
+    assert!(out.join("slivers.regions.txt").is_file(), "{stderr}");
+
+    let labels = dir.join("labels");
+    std::fs::create_dir_all(&labels).unwrap();
+    std::fs::copy(
+        humanoids.join("humanoids_00.labels.txt"),
+        labels.join("humanoids_00.labels.txt"),
+    )
+    .unwrap();
+    let out = dir.join("propagate");
+    let o = coseg(&[
+        "propagate".as_ref(),
+        shapes.as_os_str(),
+        "--labels".as_ref(),
+        labels.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    let (_, stderr) = text(&o);
+    assert_eq!(o.status.code(), Some(0), "{stderr}");
+    assert!(warned(&stderr), "{stderr}");
+    check_propagated(&out, &shapes, &[0, 1, 2, 3, 4, 5]);
+    assert_no_nan(&out);
 }

@@ -449,6 +449,32 @@ fn same_seed_same_bytes_different_seed_different_shapes() {
     }
 }
 
+/// Issue #42: `--count 1000` named its shapes `humanoids_00` … `humanoids_99`,
+/// `humanoids_100` …, which do not sort in index order.
+#[test]
+fn generated_names_are_zero_padded_to_the_count() {
+    use coseg::generate::shape_name;
+    for (count, first, last) in [
+        (6, "humanoids_00", "humanoids_05"),
+        (99, "humanoids_00", "humanoids_98"),
+        (100, "humanoids_000", "humanoids_099"),
+        (1000, "humanoids_0000", "humanoids_0999"),
+        (10_000, "humanoids_00000", "humanoids_09999"),
+    ] {
+        assert_eq!(shape_name(Family::Humanoids, 0, count), first);
+        assert_eq!(shape_name(Family::Humanoids, count - 1, count), last);
+        let names: Vec<String> = (0..count)
+            .map(|i| shape_name(Family::Humanoids, i, count))
+            .collect();
+        assert!(names.windows(2).all(|w| w[0] < w[1]), "{count}: not sorted");
+    }
+    // The names the generator gives are those (shipped collections: 6 shapes, `_00` … `_05`).
+    let mut opts = GenerateOptions::default();
+    opts.count = 1;
+    let c = generate_family(Family::Goblets, &opts).unwrap();
+    assert_eq!(c.shapes[0].name, "goblets_00");
+}
+
 #[test]
 fn bad_count_is_an_error() {
     let r = generate_family(Family::Chairs, &{

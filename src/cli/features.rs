@@ -39,7 +39,11 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
     let mut opts = args.pipeline.options()?;
-    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &opts) {
+    let spectrum_warnings = [
+        coseg::pipeline::small_mesh_warning(&mesh, &opts),
+        coseg::pipeline::unresolved_triangles_warning(&mesh),
+    ];
+    for w in spectrum_warnings.into_iter().flatten() {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
     // User features are per shape: resolve the folder to this mesh's file.

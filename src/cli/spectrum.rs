@@ -62,7 +62,11 @@ pub fn run(args: SpectrumArgs) -> Result<ExitCode> {
         opts.spectrum = options.clone();
         opts
     };
-    if let Some(w) = coseg::pipeline::small_mesh_warning(&mesh, &pipeline) {
+    let spectrum_warnings = [
+        coseg::pipeline::small_mesh_warning(&mesh, &pipeline),
+        coseg::pipeline::unresolved_triangles_warning(&mesh),
+    ];
+    for w in spectrum_warnings.into_iter().flatten() {
         eprintln!("warning: {}: {w}", args.mesh.display());
     }
     let mut options = options;

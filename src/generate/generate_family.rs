@@ -10,7 +10,8 @@ use super::{Collection, Family, GenerateError, GeneratedShape, families};
 pub struct GenerateOptions {
     /// Seed of the parameter stream (default 1, the seed of the shipped collections).
     pub seed: u64,
-    /// Number of shapes (default 6; 1–1000).
+    /// Number of shapes (default 6; 1–100,000). Names are zero-padded to the digits of the
+    /// count, at least 2 ([`shape_name`]): `humanoids_0000` … `humanoids_0999` for 1,000.
     pub count: usize,
     /// Gauss–Seidel relaxation sweeps applied to the marching-tetrahedra mesh (default 3;
     /// 0 keeps the raw marching-tetrahedra vertices).
@@ -25,6 +26,25 @@ impl Default for GenerateOptions {
             relax_iterations: 3,
         }
     }
+}
+
+/// Largest `count` [`generate_family`] accepts (about 10 GB of meshes for humanoids).
+const MAX_COUNT: usize = 100_000;
+
+/// The name of shape `index` of a collection of `count` shapes of `family`: `<family>_<index>`,
+/// the index zero-padded to the number of digits of `count`, at least 2, so that the names
+/// sort in index order whatever the count and collections of fewer than 100 shapes keep the
+/// names `chairs_00` … `chairs_99`.
+///
+/// ```
+/// use coseg::generate::{shape_name, Family};
+/// assert_eq!(shape_name(Family::Chairs, 5, 6), "chairs_05");
+/// assert_eq!(shape_name(Family::Humanoids, 7, 100), "humanoids_007");
+/// assert_eq!(shape_name(Family::Humanoids, 999, 1000), "humanoids_0999");
+/// ```
+pub fn shape_name(family: Family, index: usize, count: usize) -> String {
+    let width = count.to_string().len().max(2);
+    format!("{}_{index:0width$}", family.name())
 }
 
 /// Generates `options.count` shapes of `family` (shape `i` from ChaCha8 seeded by
@@ -45,9 +65,9 @@ pub fn generate_family(
     family: Family,
     options: &GenerateOptions,
 ) -> Result<Collection, GenerateError> {
-    if options.count == 0 || options.count > 1000 {
+    if options.count == 0 || options.count > MAX_COUNT {
         return Err(GenerateError::Options(format!(
-            "count must be in 1..=1000, got {}",
+            "count must be in 1..={MAX_COUNT}, got {}",
             options.count
         )));
     }
@@ -83,7 +103,7 @@ pub fn generate_family(
         }
         let parts_present = model.parts.iter().map(Option::is_some).collect();
         shapes.push(GeneratedShape {
-            name: format!("{}_{index:02}", family.name()),
+            name: shape_name(family, index, options.count),
             mesh,
             labels,
             parts_present,

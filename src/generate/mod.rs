@@ -32,7 +32,7 @@ mod sdf;
 mod synthetic;
 mod write_collection;
 
-pub use generate_family::{GenerateOptions, generate_family};
+pub use generate_family::{GenerateOptions, generate_family, shape_name};
 pub use marching_tetrahedra::{ScalarGrid, marching_tetrahedra};
 pub use synthetic::{SmoothFeatures, SplitMix64, grid_mesh, refine_mesh, smooth_features};
 pub use write_collection::{MANIFEST_FORMAT, Manifest, ManifestShape, obj_text, write_collection};

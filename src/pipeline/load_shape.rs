@@ -257,7 +257,11 @@ pub fn load_shape<T: ShapeContent>(
         .iter()
         .map(|w| format!("{}: {w}", path.display()))
         .collect();
-    if let Some(w) = super::small_mesh_warning(&mesh, options) {
+    let spectrum_warnings = [
+        super::small_mesh_warning(&mesh, options),
+        super::unresolved_triangles_warning(&mesh),
+    ];
+    for w in spectrum_warnings.into_iter().flatten() {
         warnings.push(format!("{}: {w}", path.display()));
     }
     let t = Instant::now();

@@ -469,6 +469,30 @@ pub fn small_mesh_warning(mesh: &TriMesh, options: &ShapePipelineOptions) -> Opt
     })
 }
 
+/// The warning for a mesh with triangles collinear up to rounding
+/// ([`crate::spectral::unresolved_triangles`]): their computed cotangents are noise, so the
+/// Laplacian treats them as zero-area (no weight, no mass) and the spectrum is that of the
+/// rest of the surface. Before 0.1.0's fix (issue #42) such triangles could make `L − σM`
+/// indefinite and the shape was dropped. `None` when there is none.
+///
+/// ```
+/// use coseg::{mesh::TriMesh, pipeline::unresolved_triangles_warning};
+/// let (a, b) = ([0.1, 0.7, 0.3], [0.9, 0.2, 0.6]);
+/// let p = [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) / 3.0); // on the edge, up to rounding
+/// let m = TriMesh::new(vec![a, b, [0.5, 1.5, 0.0], p], vec![[0, 1, 2], [0, 3, 1]]).unwrap();
+/// let w = unresolved_triangles_warning(&m).unwrap();
+/// assert!(w.starts_with("1 triangles are collinear up to rounding"), "{w}");
+/// ```
+pub fn unresolved_triangles_warning(mesh: &TriMesh) -> Option<String> {
+    let count = crate::spectral::unresolved_triangles(mesh);
+    (count > 0).then(|| {
+        format!(
+            "{count} triangles are collinear up to rounding (their cotangents are noise): \
+             the Laplacian treats them as zero-area (no weight, no mass)"
+        )
+    })
+}
+
 /// Verifies and decodes the bytes of a full cache entry written for `key` on a mesh of
 /// `vertices` vertices; `Err` says why it cannot be trusted (frame, decoding, sizes,
 /// non-finite numbers: see [`crate::cache::read_entry`]). Never panics, whatever the bytes.

@@ -1,8 +1,11 @@
+use super::surface_operators::{half_cotangents, weighted_vertex_areas};
 use crate::mesh::TriMesh;
 
 /// Lumped (barycentric) mass matrix `M` as its diagonal: `ω_j` = a third of the area of every
 /// triangle at vertex `j`. Length `d`, non-negative, sums to the mesh's total area (squared file
-/// units).
+/// units). Triangles that the Laplacian treats as zero-area (collinear up to rounding, see
+/// [`super::unresolved_triangles`]) carry no mass either, so the mass is the one the spectrum
+/// uses ([`super::SurfaceOperators::vertex_areas`]).
 ///
 /// ```
 /// use coseg::{mesh::TriMesh, spectral::lumped_mass};
@@ -11,5 +14,5 @@ use crate::mesh::TriMesh;
 /// assert!((m.iter().sum::<f64>() - 0.5).abs() < 1e-12);
 /// ```
 pub fn lumped_mass(mesh: &TriMesh) -> Vec<f64> {
-    mesh.vertex_areas()
+    weighted_vertex_areas(mesh, mesh.faces(), &half_cotangents(mesh))
 }

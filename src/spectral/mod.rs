@@ -27,7 +27,7 @@ pub use laplace_beltrami_spectrum::{
     laplace_beltrami_spectrum, laplace_beltrami_spectrum_with_stats,
 };
 pub use lumped_mass::lumped_mass;
-pub use surface_operators::{LaplacianKind, SurfaceOperators};
+pub use surface_operators::{LaplacianKind, SurfaceOperators, unresolved_triangles};
 
 use thiserror::Error;
 

@@ -2,7 +2,7 @@
 //! one rule for clamped and degenerate triangles, shared by the spectrum, the heat smoother
 //! and the mean curvature.
 
-use super::cotangent_weights::{assemble, halved_within_bound};
+use super::cotangent_weights::{assemble, halved_within_bound, resolved};
 use crate::mesh::{TriMesh, cross, dot, norm, sub};
 use faer::sparse::SparseColMat;
 
@@ -48,13 +48,17 @@ impl std::str::FromStr for LaplacianKind {
 /// - `half_cotangents`: `F × 3`, `cot(θ_k) / 2` of the angle at corner `k` of each face (the
 ///   weight of the opposite edge `(k+1, k+2)`), under **the one rule** of this crate: a face
 ///   with a corner of zero, negative or non-finite `|u × v|` is degenerate and gets three
-///   zeros; a face whose largest `|cot|` exceeds `MAX_COTANGENT` has all three scaled by the
+///   zeros, and so does a face whose computed cotangents are rounding noise (collinear up to
+///   rounding: they break `c₀c₁ + c₁c₂ + c₂c₀ = 1`, see [`unresolved_triangles`]); a face
+///   whose largest `|cot|` exceeds `MAX_COTANGENT` has all three scaled by the
 ///   same factor (keeps each face's stiffness matrix positive semi-definite, whereas clamping
 ///   each cotangent apart can make a needle triangle indefinite);
 /// - `laplacian`: `d × d`, the weak cotangent Laplacian `L` assembled from those weights,
 ///   `L_ij = −Σ half-cotangents of edge ij`, `L_ii = −Σ_j L_ij` (so `L 1 = 0`), symmetric
 ///   positive semi-definite, dimensionless (the same for the mesh scaled to unit area);
-/// - `vertex_areas`: length `d`, the barycentric (lumped) vertex areas as read;
+/// - `vertex_areas`: length `d`, the barycentric (lumped) vertex areas as read, from the
+///   faces with weights (a degenerate face has no area to give, or none that rounding
+///   resolves);
 /// - `unit_mass`: length `d`, the barycentric (lumped) vertex areas of the mesh scaled to
 ///   unit total area (they sum to 1 up to rounding; unreferenced vertices get 0);
 /// - `total_area`: the mesh's area as read, squared file units.
@@ -84,7 +88,9 @@ pub struct SurfaceOperators {
 impl SurfaceOperators {
     /// Computes the operators of `mesh`: O(F) time and memory.
     pub fn new(mesh: &TriMesh) -> Self {
-        Self::on(mesh, None, half_cotangents(mesh), mesh.vertex_areas())
+        let weights = half_cotangents(mesh);
+        let areas = weighted_vertex_areas(mesh, mesh.faces(), &weights);
+        Self::on(mesh, None, weights, areas)
     }
 
     /// The operators from per-corner weights on `faces` (`None`: the mesh's own) and lumped
@@ -207,22 +213,63 @@ pub(super) fn laplacian(mesh: &TriMesh) -> SparseColMat<usize, f64> {
 }
 
 /// The per-corner half-cotangents of every face under the rule of [`SurfaceOperators`].
-fn half_cotangents(mesh: &TriMesh) -> Vec<[f64; 3]> {
+pub(super) fn half_cotangents(mesh: &TriMesh) -> Vec<[f64; 3]> {
     (0..mesh.face_count())
-        .map(|f| {
-            let p = mesh.corners(f);
-            // Cotangent of the angle at each corner k, opposite edge (k+1, k+2).
-            let mut cot = [0.0f64; 3];
-            for (k, ck) in cot.iter_mut().enumerate() {
-                let u = sub(p[(k + 1) % 3], p[k]);
-                let v = sub(p[(k + 2) % 3], p[k]);
-                let c = norm(cross(u, v));
-                if c.is_nan() || c <= 0.0 || !c.is_finite() {
-                    return [0.0; 3];
-                }
-                *ck = dot(u, v) / c;
-            }
-            halved_within_bound(cot)
-        })
+        .map(|f| corner_cotangents(mesh.corners(f)).map_or([0.0; 3], halved_within_bound))
         .collect()
+}
+
+/// Cotangent of the angle at each corner `k` (opposite edge `(k+1, k+2)`); `None` for a
+/// degenerate triangle (a corner of zero, negative or non-finite `|u × v|`).
+fn corner_cotangents(p: [[f64; 3]; 3]) -> Option<[f64; 3]> {
+    let mut cot = [0.0f64; 3];
+    for (k, ck) in cot.iter_mut().enumerate() {
+        let u = sub(p[(k + 1) % 3], p[k]);
+        let v = sub(p[(k + 2) % 3], p[k]);
+        let c = norm(cross(u, v));
+        if c.is_nan() || c <= 0.0 || !c.is_finite() {
+            return None;
+        }
+        *ck = dot(u, v) / c;
+    }
+    Some(cot)
+}
+
+/// Vertex areas of the triangles that carry weights (`half_cotangents` not all zero): the
+/// lumped mass of [`TriMesh::vertex_areas`], without the triangles the rule of
+/// [`SurfaceOperators`] treats as zero-area. Summed in the same order, so a mesh with no such
+/// triangle gets the same bits.
+pub(super) fn weighted_vertex_areas(
+    mesh: &TriMesh,
+    faces: &[[u32; 3]],
+    half_cotangents: &[[f64; 3]],
+) -> Vec<f64> {
+    let mut w = vec![0.0; mesh.vertex_count()];
+    for ((f, a), hc) in faces.iter().zip(mesh.face_areas()).zip(half_cotangents) {
+        if *hc == [0.0; 3] {
+            continue;
+        }
+        for &i in f {
+            w[i as usize] += a / 3.0;
+        }
+    }
+    w
+}
+
+/// How many triangles of `mesh` have a positive area as computed, yet cotangents that are
+/// rounding noise, which the rule of [`SurfaceOperators`] treats as zero-area (no weight, no
+/// mass): triangles whose vertices are collinear up to rounding. 0 on every sound mesh. O(F).
+///
+/// ```
+/// use coseg::{mesh::TriMesh, spectral::unresolved_triangles};
+/// // A vertex a third of the way along the edge 0–1, which rounding puts a hair off it.
+/// let (a, b) = ([0.1, 0.7, 0.3], [0.9, 0.2, 0.6]);
+/// let p = [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) / 3.0);
+/// let m = TriMesh::new(vec![a, b, [0.5, 1.5, 0.0], p], vec![[0, 1, 2], [0, 3, 1]]).unwrap();
+/// assert_eq!(unresolved_triangles(&m), 1);
+/// ```
+pub fn unresolved_triangles(mesh: &TriMesh) -> usize {
+    (0..mesh.face_count())
+        .filter(|&f| corner_cotangents(mesh.corners(f)).is_some_and(|cot| !resolved(cot)))
+        .count()
 }

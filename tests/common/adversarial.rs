@@ -123,6 +123,26 @@ fn degenerate() -> Parts {
     (p, f)
 }
 
+/// `parts` with, on `count` of its faces (every `faces / count`-th), a vertex a third of the
+/// way along the face's first edge `ab` and the "zero-area" triangle `(a, p, b)` over that
+/// edge: collinear in exact arithmetic, a hair off in floating point, so its cotangents are
+/// rounding noise. Each of those faces is also repeated (a duplicated triangle) and a
+/// triangle with a repeated vertex `(a, a, b)` added. Meshes like this (a benchmark mesh with
+/// 20 zero-area triangles) were dropped: `eigensolver failed: Cholesky of L − σM
+/// (σ = −10): NonPositivePivot` (issue #42).
+pub fn with_collinear_slivers(parts: Parts, count: usize) -> Parts {
+    let (mut p, mut f) = parts;
+    let stride = (f.len() / count.max(1)).max(1);
+    let chosen: Vec<[u32; 3]> = f.iter().step_by(stride).take(count).copied().collect();
+    for [a, b, c] in chosen {
+        let (pa, pb) = (p[a as usize], p[b as usize]);
+        p.push([0, 1, 2].map(|k| pa[k] + (pb[k] - pa[k]) / 3.0));
+        let v = (p.len() - 1) as u32;
+        f.extend([[a, v, b], [a, b, c], [a, a, b]]);
+    }
+    (p, f)
+}
+
 /// An icosphere where every vertex on one meridian side is stored twice (faces on the two
 /// sides use different copies, so the surface is cut open along a seam), plus unreferenced
 /// vertices.
@@ -200,6 +220,16 @@ pub fn corpus() -> Vec<Case> {
             file: "degenerate.ply",
             what: "zero-area and needle triangles",
             parts: degenerate(),
+        },
+        Case {
+            file: "collinear_slivers.off",
+            what: "20 triangles collinear up to rounding, duplicated triangles (642 + 20 vertices: \
+                   the sparse eigensolver)",
+            parts: {
+                let (mut p, f) = icosphere_parts(3, 1.0);
+                jitter(&mut p, 0.01, 11);
+                with_collinear_slivers((p, f), 20)
+            },
         },
         Case {
             file: "duplicates.off",
