@@ -434,7 +434,6 @@ fn pair<'py>(
                 },
                 &options,
             )?;
-            let regions = pair.regions;
             let seconds = t.elapsed().as_secs_f64();
             let summary_shape = |s: &Shape| ShapeSummary {
                 name: s.name.clone(),
@@ -442,18 +441,14 @@ fn pair<'py>(
                 vertices: s.mesh.vertex_count(),
                 area: s.mesh.total_area(),
             };
-            let summary = PairSummary::new(
+            let summary = PairSummary::of_pair(
                 [summary_shape(&shapes[0]), summary_shape(&shapes[1])],
-                &regions,
-                &options.regions,
+                &pair,
+                &options,
                 None,
                 seconds,
-            )
-            .with_refine(options.refine)
-            .with_map_guided(pair.map_guided.clone())
-            .with_map_preset(pair.map_preset)
-            .with_fallbacks(pair.fallbacks);
-            Ok((regions, summary))
+            );
+            Ok((pair.regions, summary))
         })
         .map_err(|e| input_err(e.to_string()))?;
     let (la, lb) = (regions.labels_a(), regions.labels_b());
@@ -641,17 +636,7 @@ fn segment<'py>(
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
     let written = match &out_dir {
         Some(dir) => {
-            let list: Vec<ShapeRegions> = seg
-                .names
-                .iter()
-                .zip(&meshes)
-                .zip(&labels)
-                .map(|((name, mesh), regions)| ShapeRegions {
-                    name,
-                    mesh,
-                    regions,
-                })
-                .collect();
+            let list = ShapeRegions::collection(&seg.names, &meshes, &labels);
             py.detach(|| write_regions(dir, &list, &summary))
                 .or_raise()?
         }

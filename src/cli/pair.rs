@@ -258,32 +258,28 @@ pub fn run(args: PairArgs) -> Result<ExitCode> {
     let (ma, mb) = (&loaded[0].0, &loaded[1].0);
     let t = Instant::now();
     let pair = segment_loaded(&args, &loaded, &pair_options)?;
-    let regions = pair.regions;
+    let regions = &pair.regions;
     let seconds = t.elapsed().as_secs_f64();
     let ratio = match &args.ground_truth {
         None => None,
-        Some(s) if s == "identity" => Some(correspondence_ratio(&regions, &VertexMap::Identity)?),
-        Some(file) => Some(correspondence_ratio(&regions, &VertexMap::read(file)?)?),
+        Some(s) if s == "identity" => Some(correspondence_ratio(regions, &VertexMap::Identity)?),
+        Some(file) => Some(correspondence_ratio(regions, &VertexMap::read(file)?)?),
     };
     let (mut na, nb) = (stem(&args.a), stem(&args.b));
     if na == nb {
         na = format!("{na}_a");
     }
     let (la, lb) = (regions.labels_a(), regions.labels_b());
-    let summary = PairSummary::new(
+    let summary = PairSummary::of_pair(
         [
             shape_summary(&na, &args.a, ma),
             shape_summary(&nb, &args.b, mb),
         ],
-        &regions,
-        &pair_options.regions,
+        &pair,
+        &pair_options,
         ratio,
         seconds,
-    )
-    .with_refine(pair_options.refine)
-    .with_map_guided(pair.map_guided.clone())
-    .with_map_preset(pair.map_preset)
-    .with_fallbacks(pair.fallbacks);
+    );
     let shapes = [
         ShapeRegions {
             name: &na,

@@ -199,17 +199,7 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
         summary.parts = Some(report);
     }
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
-    let shapes: Vec<ShapeRegions> = seg
-        .names
-        .iter()
-        .zip(&loaded.meshes)
-        .zip(&labels)
-        .map(|((name, mesh), regions)| ShapeRegions {
-            name,
-            mesh,
-            regions,
-        })
-        .collect();
+    let shapes = ShapeRegions::collection(&seg.names, &loaded.meshes, &labels);
     let mut written = write_regions(&args.out, &shapes, &summary)?;
     if !args.no_pictures {
         written.extend(draw(&args.out, &shapes, &summary)?);

@@ -2,7 +2,10 @@
 
 use crate::maps::MapGuidedOptions;
 use crate::maps::PresetChoice;
-use crate::stable::{RefineOptions, StableRegions, StableRegionsOptions, StageFallback};
+use crate::stable::{
+    RefineOptions, SegmentPairOptions, SegmentedPair, StableRegions, StableRegionsOptions,
+    StageFallback,
+};
 use serde::Serialize;
 
 /// One shape of a pair run.
@@ -123,6 +126,29 @@ impl PairSummary {
             correspondence_ratio,
             seconds,
         }
+    }
+
+    /// The summary of a [`segment_pair`](crate::stable::segment_pair) run, `pair`, with
+    /// `options` (what `coseg pair` writes): [`PairSummary::new`] on the pair's regions with its
+    /// refinement, map step, preset and fallbacks recorded.
+    pub fn of_pair(
+        shapes: [ShapeSummary; 2],
+        pair: &SegmentedPair,
+        options: &SegmentPairOptions,
+        correspondence_ratio: Option<f64>,
+        seconds: f64,
+    ) -> Self {
+        Self::new(
+            shapes,
+            &pair.regions,
+            &options.regions,
+            correspondence_ratio,
+            seconds,
+        )
+        .with_refine(options.refine.clone())
+        .with_map_guided(pair.map_guided.clone())
+        .with_map_preset(pair.map_preset)
+        .with_fallbacks(pair.fallbacks.clone())
     }
 
     /// Records that the regions were refined with `refine` (see

@@ -17,6 +17,35 @@ pub struct ShapeRegions<'a> {
 }
 
 impl<'a> ShapeRegions<'a> {
+    /// One entry per shape of a collection, `names[i]` with `meshes[i]` and `labels[i]` (the
+    /// three in the same order, e.g. a co-segmentation's names, its meshes and
+    /// `segmentation.labels(i)`), as `coseg segment` writes them.
+    ///
+    /// ```
+    /// use coseg::mesh::TriMesh;
+    /// use coseg::output::ShapeRegions;
+    /// let m = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
+    /// let (names, meshes, labels) = (vec!["a".to_string()], vec![m], vec![vec![0, 0, 1]]);
+    /// let shapes = ShapeRegions::collection(&names, &meshes, &labels);
+    /// assert_eq!((shapes[0].name, shapes[0].regions), ("a", &[0, 0, 1][..]));
+    /// ```
+    pub fn collection(
+        names: &'a [String],
+        meshes: &'a [TriMesh],
+        labels: &'a [Vec<i32>],
+    ) -> Vec<Self> {
+        names
+            .iter()
+            .zip(meshes)
+            .zip(labels)
+            .map(|((name, mesh), regions)| ShapeRegions {
+                name,
+                mesh,
+                regions,
+            })
+            .collect()
+    }
+
     /// The shape as the pictures draw it (coloured by region, no confidence).
     pub fn picture(&self) -> crate::render::RenderShape<'a> {
         crate::render::RenderShape {
