@@ -98,7 +98,7 @@ fn humanoids_parts_from_geometry_meet_the_bar() {
 
 #[test]
 fn chairs_parts_from_geometry_meet_the_bar() {
-    // Measured 0.906 / 0.786. 0.1.0-dev.21 (regions split into their pieces, every sibling merge
+    // Measured 0.906 / 0.786. commit 6256292 (regions split into their pieces, every sibling merge
     // at an extra cost): 0.907 / 0.731, the front and back legs two parts; now their feet,
     // facing the same way, are copies linked like mirror pairs (docs/PARTS.md, "Copies and
     // look-alikes").

@@ -294,7 +294,7 @@ fn geometric_part_tree_with_cues_is_the_tree_and_refuses_cues_that_do_not_fit() 
     assert!(matches!(tree(&cues[..2]), Err(GraphError::BadOption(_))));
 }
 
-/// Regression (`leaves never on one shape together`, 0.1.0-dev.22): complete linkage took the
+/// Regression (`leaves never on one shape together`, commit e19446f): complete linkage took the
 /// thickness distance of two leaves that are never present on one shape together as infinite,
 /// so any group holding both could never merge with anything at a finite cost (on generated
 /// chairs, the feet of every leg stayed a part of their own). Pairs that are never together
