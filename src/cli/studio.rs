@@ -14,7 +14,7 @@ use serde_json::{Value, json};
 use std::io::{Read, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::{Arc, Mutex, TryLockError};
+use std::sync::{Arc, Mutex, RwLock};
 use tiny_http::{Header, Method, Request, Response, Server};
 
 /// The page: plain JavaScript and WebGL, embedded in the binary.
@@ -57,7 +57,9 @@ struct Progress {
 }
 
 struct App {
-    studio: Mutex<Studio>,
+    /// Requests that only look take it shared (the grid's pictures load in parallel); edits
+    /// and the propagation take it alone.
+    studio: RwLock<Studio>,
     progress: Mutex<Progress>,
     token: String,
     port: u16,
@@ -106,7 +108,7 @@ pub fn run(args: StudioArgs) -> Result<ExitCode> {
         open_browser(&url);
     }
     let app = Arc::new(App {
-        studio: Mutex::new(studio),
+        studio: RwLock::new(studio),
         progress: Mutex::new(Progress::default()),
         token,
         port,
@@ -331,6 +333,10 @@ fn route(app: &Arc<App>, rq: &mut Request) -> Reply {
             ),
         );
     }
+    // Browsers ask for an icon; there is none, and a 404 would be a console error.
+    if method == Method::Get && path == "/favicon.ico" {
+        return reply(204, "image/x-icon", Vec::new());
+    }
     if method == Method::Get && path == "/api/progress" {
         let p = app.progress.lock().unwrap_or_else(|e| e.into_inner());
         return json_reply(
@@ -350,47 +356,23 @@ fn route(app: &Arc<App>, rq: &mut Request) -> Reply {
     if method == Method::Post && path == "/api/propagate" {
         return start_propagation(app);
     }
-    // One request at a time edits the session; while a propagation holds it, say so rather
-    // than hang the page.
-    let mut studio = match app.studio.try_lock() {
-        Ok(s) => s,
-        Err(TryLockError::WouldBlock) => return error(409, "busy: a propagation is running"),
-        Err(TryLockError::Poisoned(e)) => e.into_inner(),
-    };
+    // Looking waits for a running edit; an edit while a propagation holds the session is
+    // refused rather than left hanging the page.
+    if method == Method::Get {
+        let studio = app.studio.read().unwrap_or_else(|e| e.into_inner());
+        return look(&studio, &path, &url).unwrap_or_else(|r| r);
+    }
+    if app
+        .progress
+        .lock()
+        .unwrap_or_else(|e| e.into_inner())
+        .running
+    {
+        return error(409, "busy: a propagation is running");
+    }
+    let mut studio = app.studio.write().unwrap_or_else(|e| e.into_inner());
     let result: Result<Reply, Reply> = (|| {
         Ok(match (method, path.as_str()) {
-            (Method::Get, "/api/state") => json_reply(200, &state(&studio)),
-            (Method::Get, "/api/shape") => {
-                let i = shape_param(&url)?;
-                let positions = studio.view_positions(i).map_err(studio_error)?;
-                let mesh = studio.mesh(i).map_err(studio_error)?;
-                json_reply(
-                    200,
-                    &json!({
-                        "index": i,
-                        "positions": positions.concat(),
-                        "faces": mesh.faces().concat(),
-                        "patches": studio.patches(i).map_err(studio_error)?,
-                        "labels": studio.labels(i).map_err(studio_error)?,
-                    }),
-                )
-            }
-            (Method::Get, "/api/labels") => {
-                let i = shape_param(&url)?;
-                json_reply(200, &labels_json(&studio, i)?)
-            }
-            (Method::Get, "/api/thumb") => {
-                let i = shape_param(&url)?;
-                let size = query_param(&url, "size")
-                    .map(|s| {
-                        s.parse::<u32>()
-                            .map_err(|_| error(400, "size: not a number"))
-                    })
-                    .transpose()?
-                    .unwrap_or(160);
-                let png = studio.thumbnail(i, size).map_err(studio_error)?;
-                reply(200, "image/png", png)
-            }
             (Method::Post, "/api/label") => {
                 let r: LabelRequest = parse(body)?;
                 let edit = match (r.patch, r.vertices) {
@@ -442,12 +424,55 @@ fn route(app: &Arc<App>, rq: &mut Request) -> Reply {
             (Method::Post, "/api/export") => {
                 let r: ExportRequest = parse(body)?;
                 let files = studio.export(&r.dir).map_err(studio_error)?;
-                json_reply(200, &json!({ "files": files.len() }))
+                let dir = studio.folder().join(&r.dir);
+                json_reply(
+                    200,
+                    &json!({ "files": files.len(), "dir": dir.display().to_string() }),
+                )
             }
             (m, p) => return Err(error(404, format!("no such request: {m} {p}"))),
         })
     })();
     result.unwrap_or_else(|r| r)
+}
+
+/// The requests that only read the session.
+fn look(studio: &Studio, path: &str, url: &str) -> Result<Reply, Reply> {
+    Ok(match path {
+        "/api/state" => json_reply(200, &state(studio)),
+        "/api/shape" => {
+            let i = shape_param(url)?;
+            let positions = studio.view_positions(i).map_err(studio_error)?;
+            let mesh = studio.mesh(i).map_err(studio_error)?;
+            json_reply(
+                200,
+                &json!({
+                    "index": i,
+                    "positions": positions.concat(),
+                    "faces": mesh.faces().concat(),
+                    "patches": studio.patches(i).map_err(studio_error)?,
+                    "labels": studio.labels(i).map_err(studio_error)?,
+                }),
+            )
+        }
+        "/api/labels" => {
+            let i = shape_param(url)?;
+            json_reply(200, &labels_json(studio, i)?)
+        }
+        "/api/thumb" => {
+            let i = shape_param(url)?;
+            let size = query_param(url, "size")
+                .map(|s| {
+                    s.parse::<u32>()
+                        .map_err(|_| error(400, "size: not a number"))
+                })
+                .transpose()?
+                .unwrap_or(160);
+            let png = studio.thumbnail(i, size).map_err(studio_error)?;
+            reply(200, "image/png", png)
+        }
+        p => return Err(error(404, format!("no such request: GET {p}"))),
+    })
 }
 
 fn parse_color(text: &str) -> Result<[u8; 3], Reply> {
@@ -495,7 +520,7 @@ fn start_propagation(app: &Arc<App>) -> Reply {
     let app_ptr = app.clone();
     std::thread::spawn(move || {
         let result = {
-            let mut studio = app_ptr.studio.lock().unwrap_or_else(|e| e.into_inner());
+            let mut studio = app_ptr.studio.write().unwrap_or_else(|e| e.into_inner());
             studio.propagate(|step| {
                 let mut p = app_ptr.progress.lock().unwrap_or_else(|e| e.into_inner());
                 p.done = step.done;
