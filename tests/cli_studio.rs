@@ -6,98 +6,10 @@
 mod common;
 
 use common::generate::collections_dir;
-use std::io::{BufRead, BufReader, Read, Write};
+use common::studio::{Server, request, start};
 use std::net::{SocketAddr, TcpStream, UdpSocket};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
 use std::time::Duration;
-
-/// A running `coseg studio`; killed on drop.
-pub struct Server {
-    child: Child,
-    pub port: u16,
-    pub token: String,
-}
-
-impl Drop for Server {
-    fn drop(&mut self) {
-        self.child.kill().ok();
-        self.child.wait().ok();
-    }
-}
-
-/// Starts `coseg studio folder` with a small pipeline and reads its printed address.
-pub fn start(folder: &Path, cache: &Path) -> Server {
-    let mut child = Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .arg("studio")
-        .arg(folder)
-        .arg("--cache")
-        .arg(cache)
-        .args([
-            "--eigenpairs",
-            "30",
-            "--hks",
-            "8",
-            "--wks",
-            "8",
-            "--curvature",
-            "8",
-        ])
-        .args(["--bands", "8"])
-        .stdout(Stdio::piped())
-        .stderr(Stdio::inherit())
-        .spawn()
-        .expect("run coseg studio");
-    let mut lines = BufReader::new(child.stdout.take().unwrap()).lines();
-    let url = loop {
-        let line = lines.next().expect("studio printed its address").unwrap();
-        if let Some(u) = line.strip_prefix("open ") {
-            break u.to_string();
-        }
-    };
-    // Keep reading stdout so that the server never blocks on a full pipe.
-    std::thread::spawn(move || for _ in lines {});
-    let rest = url
-        .strip_prefix("http://127.0.0.1:")
-        .expect("a loopback address");
-    let (port, token) = rest.split_once("/?token=").unwrap();
-    Server {
-        child,
-        port: port.parse().unwrap(),
-        token: token.to_string(),
-    }
-}
-
-/// One HTTP/1.1 request; returns the status and the body.
-pub fn request(
-    port: u16,
-    method: &str,
-    path: &str,
-    headers: &[(&str, &str)],
-    body: &str,
-) -> (u16, String) {
-    let mut s = TcpStream::connect(("127.0.0.1", port)).unwrap();
-    s.set_read_timeout(Some(Duration::from_secs(120))).unwrap();
-    let mut req = format!(
-        "{method} {path} HTTP/1.1\r\nConnection: close\r\nContent-Length: {}\r\n",
-        body.len()
-    );
-    if !headers.iter().any(|(k, _)| k.eq_ignore_ascii_case("host")) {
-        req.push_str(&format!("Host: 127.0.0.1:{port}\r\n"));
-    }
-    for (k, v) in headers {
-        req.push_str(&format!("{k}: {v}\r\n"));
-    }
-    req.push_str("\r\n");
-    req.push_str(body);
-    s.write_all(req.as_bytes()).unwrap();
-    let mut out = Vec::new();
-    s.read_to_end(&mut out).unwrap();
-    let text = String::from_utf8_lossy(&out).to_string();
-    let status = text[9..12].parse().unwrap();
-    let body = text.split_once("\r\n\r\n").map_or("", |x| x.1).to_string();
-    (status, body)
-}
 
 fn goblets(dir: &Path) -> std::path::PathBuf {
     let folder = dir.join("shapes");

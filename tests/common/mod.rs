@@ -8,6 +8,7 @@ pub mod graph;
 pub mod mesh;
 pub mod shapes;
 pub mod stable;
+pub mod studio;
 
 /// The evaluation data folder (`../shared/data`: TOSCA, FAUST, COSEG chairs) from the
 /// environment variable `COSEG_DATA`, or `None` after saying that `test` is skipped: no test CI
