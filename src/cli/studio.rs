@@ -113,17 +113,33 @@ pub fn run(args: StudioArgs) -> Result<ExitCode> {
         token,
         port,
     });
-    let server = Arc::new(server);
+    // The progress bar's poll is answered by the thread that accepts requests (it only reads
+    // a counter), so that it is never queued behind requests waiting for a propagation.
+    let (queue, inbox) = std::sync::mpsc::channel::<Request>();
+    let inbox = Arc::new(Mutex::new(inbox));
     let workers: Vec<_> = (0..WORKERS)
         .map(|_| {
-            let (server, app) = (server.clone(), app.clone());
+            let (inbox, app) = (inbox.clone(), app.clone());
             std::thread::spawn(move || {
-                while let Ok(rq) = server.recv() {
-                    handle(&app, rq);
+                loop {
+                    let next = inbox.lock().unwrap_or_else(|e| e.into_inner()).recv();
+                    match next {
+                        Ok(rq) => handle(&app, rq),
+                        Err(_) => break,
+                    }
                 }
             })
         })
         .collect();
+    for rq in server.incoming_requests() {
+        let path = rq.url().split('?').next().unwrap_or("");
+        if *rq.method() == Method::Get && path == "/api/progress" {
+            handle(&app, rq);
+        } else if queue.send(rq).is_err() {
+            break;
+        }
+    }
+    drop(queue);
     for w in workers {
         w.join().ok();
     }
