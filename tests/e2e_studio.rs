@@ -589,6 +589,21 @@ fn a_labelling_session_in_a_real_browser_labels_propagates_corrects_and_saves() 
     b.wait("window.studioTest.steps === 4", "the undo of the erase");
     assert_eq!(b.shown_labels(), labelled0, "the erase was not undone");
     b.keys(&["e"]);
+    // [ and ] resize the brush: down to the slider's minimum, and up again from there.
+    let radius = || {
+        b.js(
+            "return +document.getElementById('radius').value;",
+            json!([]),
+        )
+        .as_f64()
+        .unwrap()
+    };
+    for _ in 0..12 {
+        b.keys(&["["]);
+    }
+    assert_eq!(radius(), 0.01, "[ did not reach the smallest brush");
+    b.keys(&["]"]);
+    assert!(radius() > 0.01, "] did not grow the smallest brush");
     b.keys(&["p"]);
     if let Some(d) = &shots {
         b.js("window.studioTest.setView(0.35, 0.3);", json!([]));
@@ -728,7 +743,7 @@ fn a_labelling_session_in_a_real_browser_labels_propagates_corrects_and_saves() 
         t0.elapsed().as_secs_f64()
     );
 
-    // N opens the next shape of the grid, G goes back to the grid.
+    // N opens the next shape of the grid, Shift+N the previous one, G goes back to the grid.
     let order: Vec<usize> =
         serde_json::from_value(b.js("return window.studioTest.state().order;", json!([]))).unwrap();
     let next = order[(order.iter().position(|&i| i == worst).unwrap() + 1) % order.len()];
@@ -736,6 +751,11 @@ fn a_labelling_session_in_a_real_browser_labels_propagates_corrects_and_saves() 
     b.wait(
         &format!("window.studioTest.mesh() && window.studioTest.mesh().shape === {next}"),
         "the next shape (N)",
+    );
+    b.keys(&["\u{E008}", "n"]);
+    b.wait(
+        &format!("window.studioTest.mesh() && window.studioTest.mesh().shape === {worst}"),
+        "the previous shape (Shift+N)",
     );
     b.keys(&["g"]);
     b.wait(
