@@ -24,6 +24,7 @@
 //! | propagation | [`propagate`] | part labels carried from annotated shapes to a collection |
 //! | pictures | [`render`] | PNG pictures of results (CPU rasteriser, canonical view, the palette) |
 //! | output | [`output`] | region files, coloured meshes, summaries, feature export, the viewer page |
+//! | jobs | [`jobs`] | a command's whole run (inputs → options → result → files) as one call: what the CLI and Python translate to |
 //! | studio | [`studio`] | a labelling session: crease patches, palette, edits with undo, incremental propagation, save (what `coseg studio` serves) |
 //! | shape families | [`generate`] | synthetic collections with ground-truth parts |
 //! | evaluation | [`evaluate`] | scores against ground truth: accuracy, per-part IoU, Rand index, purity and coverage; whole result folders ([`evaluate::evaluate_folder`]) |
@@ -38,6 +39,7 @@ pub mod evaluate;
 pub mod features;
 pub mod generate;
 pub mod graph;
+pub mod jobs;
 pub mod labels;
 pub mod maps;
 pub mod mesh;

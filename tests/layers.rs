@@ -1,8 +1,8 @@
 //! The pipeline's stages depend one way: no module of the library names (outside comments) a
 //! module of a later stage. The order is the README's: mesh → align → per-shape operators and
 //! spectrum → features → bands → per-shape pipeline → affinity → maps → stable → graph → parts →
-//! propagate → evaluate → output → studio. Doc links may point forward; code may not. Within a module,
-//! no two files import each other, directly or around a longer circle.
+//! propagate → evaluate → output → jobs → studio. Doc links may point forward; code may not.
+//! Within a module, no two files import each other, directly or around a longer circle.
 
 use std::path::Path;
 
@@ -29,6 +29,7 @@ const ORDER: &[&str] = &[
     "evaluate",
     "render",
     "output",
+    "jobs",
     "studio",
 ];
 

@@ -369,7 +369,9 @@ def pair(
     ``labels_a`` (``n_a`` int32, region id per vertex of A; the last region is the
     leftovers), ``labels_b``, ``summary`` (the content of ``coseg pair``'s summary.json) and
     ``written`` (files written to ``out``, if given: ``<name>.regions.txt``,
-    ``<name>.regions.ply``, ``summary.json``, the same files as the CLI's).
+    ``<name>.regions.ply``, ``summary.json``, the same files as the CLI's) and ``warnings``
+    (the messages ``coseg pair`` prints, each naming its shape: the meshes', the cache's, the
+    stages that fell back). Runs the library's pair job (``coseg::jobs::run_pair``), as the CLI.
 
     Options (defaults as ``coseg pair``): ``algorithm`` ``"fixed"`` (Algorithm 2) or
     ``"auto"`` (Algorithm 3); ``pairs`` (10) region pairs; ``alpha`` (0.1) area cutoff per

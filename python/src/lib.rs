@@ -7,23 +7,21 @@ mod options;
 
 use coseg::cache::CacheOutcome;
 use coseg::graph::{ShapeNode, load_collection};
-use coseg::parts::{SegmentCollectionOptions, segment_collection};
+use coseg::jobs::{CacheChoice, JobError, JobShape, PairJob, run_pair};
 use coseg::labels::{LabelKind, PartNames, read_part_names, read_shape_labels};
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
 use coseg::output::{
-    CollectionSummary, PairSummary, PropagationSummary, ShapeRegions, ShapeSummary, SkippedInput,
-    write_propagation, write_regions,
+    CollectionSummary, PropagationSummary, ShapeRegions, SkippedInput, write_propagation,
+    write_regions,
 };
-use coseg::pipeline::{
-    ShapePipelineOptions, compute_shape_data, load_or_compute, load_or_compute_bands,
-};
+use coseg::parts::{SegmentCollectionOptions, segment_collection};
+use coseg::pipeline::{ShapePipelineOptions, compute_shape_data, load_or_compute_bands};
 use coseg::propagate::{
     PropagateCollectionOptions, PropagateError, PropagatedCollection, SourceFile,
     propagate_collection, propagate_loaded,
 };
 use coseg::shape_task;
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
-use coseg::stable::{PairShape, segment_pair};
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
 use options::Opts;
@@ -330,6 +328,15 @@ struct Shape {
 }
 
 impl Shape {
+    /// The shape as a job's input: its mesh, its name, and the file it was read from.
+    fn into_job_shape(self) -> JobShape {
+        JobShape::Mesh {
+            file: self.from_file.then(|| PathBuf::from(&self.file)),
+            name: self.name,
+            mesh: self.mesh,
+        }
+    }
+
     /// The pipeline options for this shape: user features (`user:DIR`) resolved to its file,
     /// `DIR/<stem>.npy` or `.csv`, by the stem of the file it was read from or, for arrays, by
     /// its name (as the CLI resolves them per mesh file).
@@ -392,90 +399,36 @@ fn pair<'py>(
     let out_dir: Option<PathBuf> = o.take("out")?;
     let pair_opts = o.pair()?;
     o.finish()?;
-    let mut shapes = shapes_from(&shapes, names, files)?;
+    let shapes = shapes_from(&shapes, names, files)?;
     if shapes.len() != 2 {
         return Err(input_err(format!(
             "pair needs 2 shapes, got {}",
             shapes.len()
         )));
     }
-    if shapes[0].name == shapes[1].name {
-        shapes[0].name = format!("{}_a", shapes[0].name);
-    }
-    let (regions, summary) = py
-        .detach(|| -> Result<_, Box<dyn std::error::Error + Send + Sync>> {
-            let mut data = Vec::new();
-            for s in &shapes {
-                let pipe = s.pipeline(&pipe)?;
-                let d = match &cache {
-                    Some(dir) => load_or_compute(&s.mesh, &pipe, dir).map(|r| r.data),
-                    None => compute_shape_data(&s.mesh, &pipe),
-                }
-                .map_err(|e| format!("{}: {e}", s.file))?;
-                data.push(d);
-            }
-            let (da, db) = (&data[0], &data[1]);
-            let mut options = pair_opts.options();
-            // As `coseg pair`: the families' weights over the table's columns.
-            options.feature_weights = pipe.feature_weights(da.bands.features);
-            let t = std::time::Instant::now();
-            let pair = segment_pair(
-                PairShape {
-                    mesh: &shapes[0].mesh,
-                    spectrum: &da.spectrum,
-                    bands: &da.bands,
-                    descriptors: Some(&da.descriptors.values),
-                },
-                PairShape {
-                    mesh: &shapes[1].mesh,
-                    spectrum: &db.spectrum,
-                    bands: &db.bands,
-                    descriptors: Some(&db.descriptors.values),
-                },
-                &options,
-            )?;
-            let seconds = t.elapsed().as_secs_f64();
-            let summary_shape = |s: &Shape| ShapeSummary {
-                name: s.name.clone(),
-                file: s.file.clone(),
-                vertices: s.mesh.vertex_count(),
-                area: s.mesh.total_area(),
-            };
-            let summary = PairSummary::of_pair(
-                [summary_shape(&shapes[0]), summary_shape(&shapes[1])],
-                &pair,
-                &options,
-                None,
-                seconds,
-            );
-            Ok((pair.regions, summary))
-        })
-        .map_err(|e| input_err(e.to_string()))?;
-    let (la, lb) = (regions.labels_a(), regions.labels_b());
-    let written = match &out_dir {
-        Some(dir) => {
-            let list = [
-                ShapeRegions {
-                    name: &shapes[0].name,
-                    mesh: &shapes[0].mesh,
-                    regions: &la,
-                },
-                ShapeRegions {
-                    name: &shapes[1].name,
-                    mesh: &shapes[1].mesh,
-                    regions: &lb,
-                },
-            ];
-            py.detach(|| write_regions(dir, &list, &summary))
-                .or_raise()?
-        }
-        None => Vec::new(),
-    };
+    let mut job = PairJob::default();
+    job.pipeline = pipe;
+    job.pair = pair_opts.options();
+    job.cache = cache.map_or(CacheChoice::Off, CacheChoice::Dir);
+    job.output = out_dir;
+    // Python returns arrays; pictures are `coseg.render`'s.
+    job.pictures = false;
+    let [a, b]: [Shape; 2] = shapes
+        .try_into()
+        .map_err(|_| input_err("pair needs 2 shapes"))?;
+    let outcome = py
+        .detach(|| run_pair([a.into_job_shape(), b.into_job_shape()], &job))
+        .map_err(|e| match e {
+            JobError::Output(e) => lib_err(&e),
+            e => input_err(e.to_string()),
+        })?;
+    let [la, lb] = outcome.labels;
     let d = PyDict::new(py);
     d.set_item("labels_a", PyArray1::from_vec(py, la))?;
     d.set_item("labels_b", PyArray1::from_vec(py, lb))?;
-    d.set_item("summary", json(py, &summary)?)?;
-    d.set_item("written", written)?;
+    d.set_item("summary", json(py, &outcome.summary)?)?;
+    d.set_item("written", outcome.written)?;
+    d.set_item("warnings", outcome.warnings)?;
     Ok(d)
 }
 

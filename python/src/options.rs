@@ -8,8 +8,8 @@ use coseg::features::{
     parse_family_weights,
 };
 use coseg::graph::{CosegmentOptions, GraphError, GraphOptions, RefineSizes};
-use coseg::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions};
 use coseg::maps::{MapGuidedOptions, MapOverrides, MapPreset, MapStep, ZoomOutOptions};
+use coseg::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions};
 use coseg::pipeline::ShapePipelineOptions;
 use coseg::propagate::{MapStepOptions, PropagateOptions};
 use coseg::stable::{

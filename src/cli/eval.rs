@@ -1,10 +1,9 @@
 //! `coseg eval RESULT_DIR --truth DIR`: scores a result folder against ground truth.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::Args;
-use coseg::evaluate::{
-    CorrespondenceMap, EvaluateFolderOptions, FolderScores, ResultKind, evaluate_folder,
-};
+use coseg::evaluate::{CorrespondenceMap, FolderScores, ResultKind};
+use coseg::jobs::{EvalJob, run_eval};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -27,20 +26,15 @@ pub struct EvalArgs {
 }
 
 pub fn run(args: EvalArgs) -> Result<ExitCode> {
-    let mut options = EvaluateFolderOptions::default();
-    options.map = args.map.as_deref().map(|m| match m {
+    let mut job = EvalJob::default();
+    job.evaluate.map = args.map.as_deref().map(|m| match m {
         "identity" => CorrespondenceMap::Identity,
         file => CorrespondenceMap::File(file.into()),
     });
-    let scores = evaluate_folder(&args.result, &args.truth, &options)
-        .with_context(|| format!("scoring {}", args.result.display()))?;
+    job.json = args.json.clone();
+    let scores = run_eval(&args.result, &args.truth, &job)?;
     if !super::quiet() {
         print_table(&scores);
-    }
-    if let Some(path) = &args.json {
-        let text = serde_json::to_string_pretty(&scores)?;
-        coseg::mesh::write_atomic(path, |w| std::io::Write::write_all(w, text.as_bytes()))
-            .with_context(|| format!("{}", path.display()))?;
     }
     Ok(ExitCode::SUCCESS)
 }

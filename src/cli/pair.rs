@@ -1,20 +1,15 @@
 //! `coseg pair A B -o OUT`: stable region correspondences between two meshes.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use clap::{Args, ValueEnum};
-use coseg::maps::{MapOverrides, MapPreset, MapStep, PresetChoice};
-use coseg::mesh::TriMesh;
-use coseg::output::{PairSummary, ShapeRegions, ShapeSummary, write_regions, write_visuals};
-use coseg::pipeline::{PipelineError, ShapeData, ShapePipelineOptions, load_shape};
-use coseg::render::{RenderOptions, RenderShape};
+use coseg::jobs::{CacheChoice, JobShape, PairJob, PairOutcome, run_pair};
+use coseg::maps::{MapOverrides, MapPreset, MapStep};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, PairShape, PairTimes, RefineOptions, SegmentPairOptions,
-    SegmentedPair, StableRegionsOptions, TSearch, Threshold, VertexMap, correspondence_ratio,
-    segment_pair,
+    Algorithm, AreaReference, Init, RefineOptions, SegmentPairOptions, StableRegionsOptions,
+    TSearch, Threshold, VertexMap,
 };
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::Instant;
 
 #[derive(Debug, Clone, Copy, ValueEnum)]
 enum AlgorithmArg {
@@ -175,44 +170,6 @@ fn region_options(args: &PairArgs) -> StableRegionsOptions {
     opts
 }
 
-/// Both shapes through the per-shape pipeline (and the cache), side by side: warm, each
-/// shape's rebuild from its cache entry is mostly sequential work, so two at once use both
-/// cores. Warnings are printed in argument order, as if loaded one after the other.
-fn load_pair(
-    args: &PairArgs,
-    pipe: &ShapePipelineOptions,
-    cache: Option<&Path>,
-) -> Result<Vec<(TriMesh, ShapeData)>> {
-    let bar = super::progress_bar(2);
-    if let Some(b) = &bar {
-        b.set_message("per-shape data");
-    }
-    let load = |path: &std::path::PathBuf| {
-        let shape = load_shape::<ShapeData>(path, pipe, cache);
-        if let Some(b) = &bar {
-            b.inc(1);
-        }
-        shape
-    };
-    let (a, b) = rayon::join(|| load(&args.a), || load(&args.b));
-    if let Some(b) = bar {
-        b.finish_and_clear();
-    }
-    let mut loaded = Vec::new();
-    for (path, shape) in [(&args.a, a), (&args.b, b)] {
-        let shape = match shape {
-            Ok(s) => s,
-            Err(PipelineError::Mesh(e)) => return Err(e.into()),
-            Err(e) => return Err(anyhow::Error::new(e).context(format!("{}", path.display()))),
-        };
-        for w in &shape.warnings {
-            super::warn(w);
-        }
-        loaded.push((shape.mesh, shape.data));
-    }
-    Ok(loaded)
-}
-
 /// The map step the flags select: `--map-preset` (`auto`: resolved by the library from the
 /// spectra) with the flags' overrides.
 fn map_step(args: &PairArgs) -> MapStep {
@@ -230,98 +187,54 @@ fn map_step(args: &PairArgs) -> MapStep {
     }
 }
 
-/// preview.png, the two <name>.png and index.html.
-fn draw(out: &Path, shapes: &[ShapeRegions]) -> Result<Vec<PathBuf>> {
-    let pictures: Vec<RenderShape> = shapes.iter().map(ShapeRegions::picture).collect();
-    Ok(write_visuals(
-        out,
-        &pictures,
-        None,
-        &RenderOptions::default(),
-    )?)
-}
-
-fn stem(p: &Path) -> String {
-    p.file_stem()
-        .map_or_else(|| "shape".into(), |s| s.to_string_lossy().into_owned())
-}
-
 pub fn run(args: PairArgs) -> Result<ExitCode> {
-    let pipe = args.pipeline.options()?;
-    let cache = (!args.no_cache).then(|| {
-        args.cache
-            .clone()
-            .unwrap_or_else(|| args.output.join(".cache"))
-    });
-    let loaded = load_pair(&args, &pipe, cache.as_deref())?;
-    let pair_options = segment_pair_options(&args, &pipe, loaded[0].1.bands.features);
-    let (ma, mb) = (&loaded[0].0, &loaded[1].0);
-    let t = Instant::now();
-    let pair = segment_loaded(&args, &loaded, &pair_options)?;
-    let regions = &pair.regions;
-    let seconds = t.elapsed().as_secs_f64();
-    let ratio = match &args.ground_truth {
-        None => None,
-        Some(s) if s == "identity" => Some(correspondence_ratio(regions, &VertexMap::Identity)?),
-        Some(file) => Some(correspondence_ratio(regions, &VertexMap::read(file)?)?),
-    };
-    let (mut na, nb) = (stem(&args.a), stem(&args.b));
-    if na == nb {
-        na = format!("{na}_a");
-    }
-    let (la, lb) = (regions.labels_a(), regions.labels_b());
-    let summary = PairSummary::of_pair(
+    let job = pair_job(&args)?;
+    let spin = super::spinner("per-shape data, stable regions, refinement and map step");
+    let outcome = run_pair(
         [
-            shape_summary(&na, &args.a, ma),
-            shape_summary(&nb, &args.b, mb),
+            JobShape::File(args.a.clone()),
+            JobShape::File(args.b.clone()),
         ],
-        &pair,
-        &pair_options,
-        ratio,
-        seconds,
+        &job,
     );
-    let shapes = [
-        ShapeRegions {
-            name: &na,
-            mesh: ma,
-            regions: &la,
-        },
-        ShapeRegions {
-            name: &nb,
-            mesh: mb,
-            regions: &lb,
-        },
-    ];
-    let mut written = write_regions(&args.output, &shapes, &summary)?;
-    if !args.no_pictures {
-        written.extend(draw(&args.output, &shapes)?);
+    if let Some(b) = spin {
+        b.finish_and_clear();
     }
-    if super::quiet() {
-        return Ok(ExitCode::SUCCESS);
+    let outcome = outcome?;
+    for w in &outcome.warnings {
+        super::warn(w);
     }
-    report(
-        &args,
-        pair.map_preset,
-        regions.pairs.len(),
-        seconds,
-        ratio,
-        written.len(),
-        &pair.times,
-    );
+    if !super::quiet() {
+        report(&args, &outcome);
+    }
     Ok(ExitCode::SUCCESS)
 }
 
+/// The job the flags select: the flag-to-option translation kept in one place.
+fn pair_job(args: &PairArgs) -> Result<PairJob> {
+    let mut job = PairJob::default();
+    job.pipeline = args.pipeline.options()?;
+    job.pair = segment_pair_options(args);
+    job.cache = match (&args.cache, args.no_cache) {
+        (_, true) => CacheChoice::Off,
+        (Some(dir), false) => CacheChoice::Dir(dir.clone()),
+        (None, false) => CacheChoice::Auto,
+    };
+    job.output = Some(args.output.clone());
+    job.pictures = !args.no_pictures;
+    job.ground_truth = match &args.ground_truth {
+        None => None,
+        Some(s) if s == "identity" => Some(VertexMap::Identity),
+        Some(file) => Some(VertexMap::read(file)?),
+    };
+    Ok(job)
+}
+
 /// The whole pair stage's options the flags select: the flag-to-option translation kept in one
-/// place, out of `run`, next to [`region_options`] and [`map_step`] which it combines; the
-/// affinity's per-feature weights are the families' shares (`--family-weights`) over a table of
-/// `features` columns, as `coseg segment` and `coseg propagate` use them.
-fn segment_pair_options(
-    args: &PairArgs,
-    pipe: &ShapePipelineOptions,
-    features: usize,
-) -> SegmentPairOptions {
+/// place, next to [`region_options`] and [`map_step`] which it combines; the affinity's
+/// per-feature weights are left to the job (the families' shares over the band table).
+fn segment_pair_options(args: &PairArgs) -> SegmentPairOptions {
     let mut opts = SegmentPairOptions::default();
-    opts.feature_weights = pipe.feature_weights(features);
     opts.regions = region_options(args);
     opts.refine = (args.refine_rounds > 0).then(|| {
         let mut refine = RefineOptions::default();
@@ -334,67 +247,10 @@ fn segment_pair_options(
     opts
 }
 
-/// [`segment_pair`] on the two loaded shapes behind a spinner, with the stages that fell back
-/// printed as warnings; apart from `run` so that it reads as load, segment, write, report.
-fn segment_loaded(
-    args: &PairArgs,
-    loaded: &[(TriMesh, ShapeData)],
-    pair_options: &SegmentPairOptions,
-) -> Result<SegmentedPair> {
-    let (ma, da) = &loaded[0];
-    let (mb, db) = &loaded[1];
-    let spin = super::spinner("stable regions, refinement and map step");
-    let pair = segment_pair(
-        PairShape {
-            mesh: ma,
-            spectrum: &da.spectrum,
-            bands: &da.bands,
-            descriptors: Some(&da.descriptors.values),
-        },
-        PairShape {
-            mesh: mb,
-            spectrum: &db.spectrum,
-            bands: &db.bands,
-            descriptors: Some(&db.descriptors.values),
-        },
-        pair_options,
-    )
-    .with_context(|| format!("{} x {}", args.a.display(), args.b.display()))?;
-    if let Some(b) = spin {
-        b.finish_and_clear();
-    }
-    for f in &pair.fallbacks {
-        super::warn(format_args!(
-            "{} x {}: {f}",
-            args.a.display(),
-            args.b.display()
-        ));
-    }
-    Ok(pair)
-}
-
-/// One shape's entry of `summary.json`, written the same way for A and B.
-fn shape_summary(name: &str, file: &Path, mesh: &TriMesh) -> ShapeSummary {
-    ShapeSummary {
-        name: name.to_string(),
-        file: file.display().to_string(),
-        vertices: mesh.vertex_count(),
-        area: mesh.total_area(),
-    }
-}
-
 /// The lines `coseg pair` prints when not quiet: only reads the run's results, so it is kept
 /// out of `run`.
-fn report(
-    args: &PairArgs,
-    map_preset: Option<PresetChoice>,
-    pairs: usize,
-    seconds: f64,
-    ratio: Option<f64>,
-    files: usize,
-    times: &PairTimes,
-) {
-    if let Some(choice) = map_preset {
+fn report(args: &PairArgs, outcome: &PairOutcome) {
+    if let Some(choice) = outcome.pair.map_preset {
         println!(
             "map step: {} preset (eigenvalue discrepancy {:.4})",
             match choice.preset {
@@ -408,15 +264,18 @@ fn report(
         "{} x {}: {} region pairs in {:.3} s{} -> {} files in {}",
         args.a.display(),
         args.b.display(),
-        pairs,
-        seconds,
-        ratio.map_or(String::new(), |r| format!(
-            ", correspondence ratio {:.2} %",
-            100.0 * r
-        )),
-        files,
+        outcome.pair.regions.pairs.len(),
+        outcome.seconds,
+        outcome
+            .correspondence_ratio
+            .map_or(String::new(), |r| format!(
+                ", correspondence ratio {:.2} %",
+                100.0 * r
+            )),
+        outcome.written.len(),
         args.output.display()
     );
+    let times = &outcome.pair.times;
     println!(
         "stages: algorithm {:.2} s, smoothers {:.2} s, refinement {:.2} s, map step {:.2} s",
         times.algorithm.as_secs_f64(),
@@ -455,6 +314,10 @@ mod tests {
         assert_eq!(w.pair.refine_rounds, refine.max_rounds);
         assert_eq!(w.pair.smoothing_time, refine.smoothing_time);
         assert_eq!(map_step(&w.pair), MapStep::default());
+        // The whole job: `coseg pair A B -o OUT` is `PairJob::default()` writing to OUT.
+        let mut expected = PairJob::default();
+        expected.output = Some(PathBuf::from("out"));
+        assert_eq!(pair_job(&w.pair).unwrap(), expected);
         // The help's stated defaults are the presets' own.
         for preset in [MapPreset::General, MapPreset::NearIsometric] {
             let o = preset.options();

@@ -252,11 +252,34 @@ pub fn load_shape<T: ShapeContent>(
     let t = Instant::now();
     let (mesh, report) = read_mesh_with_report(path)?;
     let read_time = t.elapsed();
-    let mut warnings: Vec<String> = report
+    let reader_warnings = report
         .warnings
         .iter()
         .map(|w| format!("{}: {w}", path.display()))
         .collect();
+    let mut loaded = load_shape_from_mesh(mesh, path, options, cache_dir)?;
+    loaded.read_time = read_time;
+    loaded.warnings = [reader_warnings, loaded.warnings].concat();
+    Ok(loaded)
+}
+
+/// [`load_shape`] for a mesh already in memory (arrays from Python, a mesh built by the
+/// caller): the same warnings, cache and per-shape options, without reading a file.
+///
+/// - `mesh`: the validated mesh;
+/// - `path`: the file it came from, or any path whose stem names the shape (`name.` for a
+///   name with dots): warnings are prefixed by it and user features (`user:DIR`) are resolved
+///   to `DIR/<stem>.npy` or `.csv` by it;
+/// - returns the [`LoadedShape`] with `read_time` zero.
+///
+/// See also: [`load_shape`], which reads the mesh first.
+pub fn load_shape_from_mesh<T: ShapeContent>(
+    mesh: TriMesh,
+    path: &Path,
+    options: &ShapePipelineOptions,
+    cache_dir: Option<&Path>,
+) -> Result<LoadedShape<T>, PipelineError> {
+    let mut warnings = Vec::new();
     let spectrum_warnings = [
         super::small_mesh_warning(&mesh, options),
         super::unresolved_triangles_warning(&mesh),
@@ -277,7 +300,7 @@ pub fn load_shape<T: ShapeContent>(
         data,
         outcome,
         warnings,
-        read_time,
+        read_time: Duration::ZERO,
         shape_time: t.elapsed(),
     })
 }

@@ -35,7 +35,7 @@ mod shape_data;
 
 pub use load_shape::{
     BandsResult, CacheResult, LoadedShape, ShapeContent, load_or_compute, load_or_compute_bands,
-    load_shape,
+    load_shape, load_shape_from_mesh,
 };
 pub use shape_data::{
     PipelineError, ShapeBands, ShapeData, ShapePipelineOptions, StoredShape, compute_shape_data,

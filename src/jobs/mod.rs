@@ -1,0 +1,144 @@
+//! Jobs: a command's whole run — inputs, options, result, files — as one library call, so that
+//! the command line and the Python package only translate arguments and present results.
+//!
+//! Entry points:
+//! - [`run_pair`]`([`[`JobShape`]`; 2], &`[`PairJob`]`) -> Result<`[`PairOutcome`]`, `[`JobError`]`>`:
+//!   `coseg pair` and `coseg.pair`;
+//! - [`run_eval`]`(result, truth, &`[`EvalJob`]`) -> Result<`[`FolderScores`](crate::evaluate::FolderScores)`, `[`JobError`]`>`:
+//!   `coseg eval`;
+//! - [`align_folder`](crate::align::align_folder) (`coseg align`) lives with its stage.
+//!
+//! Each job's options struct is `#[non_exhaustive]`, and its `Default` is the command's
+//! default: `coseg pair A B -o OUT` with no other flag runs `PairJob { output: Some(OUT),
+//! ..PairJob::default() }`. Shapes are given as files or as meshes already in memory
+//! ([`JobShape`]); both go through the one per-shape loader
+//! ([`load_shape`](crate::pipeline::load_shape),
+//! [`load_shape_from_mesh`](crate::pipeline::load_shape_from_mesh)) with the same warnings.
+
+mod eval_job;
+mod pair_job;
+
+pub use eval_job::{EvalJob, run_eval};
+pub use pair_job::{PairJob, PairOutcome, run_pair};
+
+use crate::mesh::TriMesh;
+use crate::pipeline::{LoadedShape, PipelineError, ShapeContent, ShapePipelineOptions};
+use std::path::{Path, PathBuf};
+use thiserror::Error;
+
+/// Errors of a job: each names the file or the shape concerned.
+#[derive(Debug, Error)]
+pub enum JobError {
+    /// A shape's per-shape stage failed (or its mesh could not be read).
+    #[error("{name}: {source}")]
+    Shape {
+        /// The shape's file, or its name when given in memory.
+        name: String,
+        /// The pipeline's error.
+        #[source]
+        source: PipelineError,
+    },
+    /// A mesh file could not be read (the message names the file).
+    #[error(transparent)]
+    Mesh(#[from] crate::mesh::MeshError),
+    /// The stage itself failed on these shapes.
+    #[error("{context}: {source}")]
+    Stage {
+        /// The shapes concerned (`A x B`).
+        context: String,
+        /// The stage's error.
+        #[source]
+        source: Box<dyn std::error::Error + Send + Sync>,
+    },
+    /// Writing the outputs failed.
+    #[error(transparent)]
+    Output(#[from] crate::output::OutputError),
+    /// Invalid inputs or options (e.g. two shapes with one name).
+    #[error("{0}")]
+    Invalid(String),
+}
+
+/// A shape given to a job.
+#[derive(Debug, Clone)]
+pub enum JobShape {
+    /// A mesh file (.obj, .off, .ply), read by the job; its stem names the shape.
+    File(PathBuf),
+    /// A mesh already in memory.
+    Mesh {
+        /// The shape's name (output file stem).
+        name: String,
+        /// The file it came from, when known: resolves user features and prefixes warnings
+        /// (the name otherwise).
+        file: Option<PathBuf>,
+        /// The mesh.
+        mesh: TriMesh,
+    },
+}
+
+impl JobShape {
+    /// The shape's name: the file's stem, or the given name.
+    pub fn name(&self) -> String {
+        match self {
+            JobShape::File(p) => p
+                .file_stem()
+                .map_or_else(|| "shape".into(), |s| s.to_string_lossy().into_owned()),
+            JobShape::Mesh { name, .. } => name.clone(),
+        }
+    }
+
+    /// The file the shape came from, or its name (what `summary.json` records and warnings
+    /// name).
+    pub fn file(&self) -> String {
+        match self {
+            JobShape::File(p) => p.display().to_string(),
+            JobShape::Mesh { name, file, .. } => file
+                .as_ref()
+                .map_or_else(|| name.clone(), |f| f.display().to_string()),
+        }
+    }
+
+    /// The shape through the per-shape stage (and `cache`).
+    fn load<T: ShapeContent>(
+        self,
+        pipeline: &ShapePipelineOptions,
+        cache: Option<&Path>,
+    ) -> Result<LoadedShape<T>, JobError> {
+        let name = self.file();
+        match self {
+            JobShape::File(path) => crate::pipeline::load_shape(&path, pipeline, cache),
+            JobShape::Mesh { name, file, mesh } => {
+                // A trailing dot: the whole name is the stem, even with dots in it.
+                let path = file.unwrap_or_else(|| PathBuf::from(format!("{name}.")));
+                crate::pipeline::load_shape_from_mesh(mesh, &path, pipeline, cache)
+            }
+        }
+        .map_err(|source| match source {
+            PipelineError::Mesh(e) => JobError::Mesh(e),
+            source => JobError::Shape { name, source },
+        })
+    }
+}
+
+/// Where a job keeps its per-shape cache.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum CacheChoice {
+    /// `<output>/.cache` when the job writes an output folder, no cache otherwise (default).
+    #[default]
+    Auto,
+    /// This folder (read if valid, written otherwise).
+    Dir(PathBuf),
+    /// Compute everything, read and write nothing.
+    Off,
+}
+
+impl CacheChoice {
+    /// The cache folder for a job writing to `output`.
+    pub fn resolve(&self, output: Option<&Path>) -> Option<PathBuf> {
+        match self {
+            CacheChoice::Auto => output.map(|o| o.join(".cache")),
+            CacheChoice::Dir(d) => Some(d.clone()),
+            CacheChoice::Off => None,
+        }
+    }
+}

@@ -1,0 +1,166 @@
+//! The job layer (`coseg::jobs`): a command's whole run as one library call.
+
+mod common;
+
+use common::features::{blob, similarity, small_pipeline};
+use coseg::jobs::{CacheChoice, EvalJob, JobError, JobShape, PairJob, run_eval, run_pair};
+use std::path::{Path, PathBuf};
+
+fn small_job(output: Option<PathBuf>) -> PairJob {
+    let mut job = PairJob::default();
+    job.pipeline = small_pipeline(24, 4);
+    job.output = output;
+    job.pictures = false;
+    job
+}
+
+fn two_files(dir: &Path) -> [PathBuf; 2] {
+    let a = dir.join("a.off");
+    let b = dir.join("b.off");
+    coseg::mesh::write_mesh(&a, &blob(2), &[]).unwrap();
+    coseg::mesh::write_mesh(&b, &similarity(&blob(2), 1.3), &[]).unwrap();
+    [a, b]
+}
+
+fn region_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with(".regions.txt"))
+        .map(|p| {
+            let name = p.file_name().unwrap().to_string_lossy().into_owned();
+            (name, std::fs::read(&p).unwrap())
+        })
+        .collect();
+    out.sort();
+    out
+}
+
+/// A shape given as a file and the same shape given in memory (with its file named) give the
+/// same regions and the same region files: one loader behind both.
+#[test]
+fn files_and_meshes_in_memory_give_the_same_result() {
+    let dir = tempfile::tempdir().unwrap();
+    let [a, b] = two_files(dir.path());
+    let from_files = run_pair(
+        [JobShape::File(a.clone()), JobShape::File(b.clone())],
+        &small_job(Some(dir.path().join("files"))),
+    )
+    .unwrap();
+    let in_memory = |path: &Path| JobShape::Mesh {
+        name: path.file_stem().unwrap().to_string_lossy().into_owned(),
+        file: Some(path.to_path_buf()),
+        mesh: coseg::mesh::read_mesh(path).unwrap(),
+    };
+    let from_meshes = run_pair(
+        [in_memory(&a), in_memory(&b)],
+        &small_job(Some(dir.path().join("meshes"))),
+    )
+    .unwrap();
+    assert_eq!(from_files.names, ["a", "b"]);
+    assert_eq!(from_files.names, from_meshes.names);
+    assert_eq!(from_files.labels, from_meshes.labels);
+    assert!(from_files.labels[0].iter().any(|&l| l >= 0));
+    let (f, m) = (
+        region_files(&dir.path().join("files")),
+        region_files(&dir.path().join("meshes")),
+    );
+    assert_eq!(f.len(), 2);
+    assert_eq!(f, m);
+    assert_eq!(from_files.summary.shapes[0].file, a.display().to_string());
+}
+
+/// Without an output folder a job writes nothing, not even its cache (`CacheChoice::Auto`
+/// caches only beside an output).
+#[test]
+fn a_job_without_output_writes_nothing() {
+    let dir = tempfile::tempdir().unwrap();
+    let [a, b] = two_files(dir.path());
+    let before: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    let outcome = run_pair([JobShape::File(a), JobShape::File(b)], &small_job(None)).unwrap();
+    assert!(outcome.written.is_empty());
+    assert_eq!(outcome.cache_outcomes, [None, None]);
+    let after: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+    assert_eq!(before.len(), after.len());
+    assert_eq!(CacheChoice::Auto.resolve(None), None);
+    assert_eq!(
+        CacheChoice::Auto.resolve(Some(Path::new("out"))),
+        Some(PathBuf::from("out/.cache"))
+    );
+    assert_eq!(CacheChoice::Off.resolve(Some(Path::new("out"))), None);
+}
+
+/// Two shapes with one name: the first is written as `<name>_a`, nothing is overwritten.
+#[test]
+fn two_shapes_with_one_name_are_both_written() {
+    let dir = tempfile::tempdir().unwrap();
+    let [a, _] = two_files(dir.path());
+    let out = dir.path().join("out");
+    let outcome = run_pair(
+        [JobShape::File(a.clone()), JobShape::File(a)],
+        &small_job(Some(out.clone())),
+    )
+    .unwrap();
+    assert_eq!(outcome.names, ["a_a", "a"]);
+    assert_eq!(region_files(&out).len(), 2);
+}
+
+/// A file that is not a mesh is refused with an error naming it; nothing is written.
+#[test]
+fn a_bad_mesh_is_refused_with_its_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let [a, _] = two_files(dir.path());
+    let bad = dir.path().join("bad.off");
+    std::fs::write(&bad, "OFF\n3 1 0\n0 0 0\n").unwrap();
+    let out = dir.path().join("out");
+    let err = run_pair(
+        [JobShape::File(a), JobShape::File(bad)],
+        &small_job(Some(out.clone())),
+    )
+    .unwrap_err();
+    let text = err.to_string();
+    assert!(text.contains("bad.off"), "{text}");
+    assert!(matches!(err, JobError::Mesh(_) | JobError::Shape { .. }));
+    assert!(region_files_or_none(&out).is_empty());
+}
+
+fn region_files_or_none(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    if dir.exists() {
+        region_files(dir)
+    } else {
+        Vec::new()
+    }
+}
+
+/// `coseg eval`'s job scores a folder and writes the scores as JSON; a folder that cannot be
+/// scored is named in the error and no JSON is written.
+#[test]
+fn eval_job_writes_its_scores_and_names_what_it_cannot_score() {
+    let dir = tempfile::tempdir().unwrap();
+    let [a, b] = two_files(dir.path());
+    let out = dir.path().join("out");
+    let outcome = run_pair(
+        [JobShape::File(a), JobShape::File(b)],
+        &small_job(Some(out.clone())),
+    )
+    .unwrap();
+    let truth = dir.path().join("truth");
+    std::fs::create_dir(&truth).unwrap();
+    for (name, labels) in outcome.names.iter().zip(&outcome.labels) {
+        let parts: Vec<i32> = labels.iter().map(|&l| l.max(0)).collect();
+        coseg::labels::write_vertex_labels(&truth, name, &parts).unwrap();
+    }
+    let mut job = EvalJob::default();
+    job.json = Some(dir.path().join("scores.json"));
+    let scores = run_eval(&out, &truth, &job).unwrap();
+    assert_eq!(scores.shapes.len(), 2);
+    let text = std::fs::read_to_string(dir.path().join("scores.json")).unwrap();
+    let json: serde_json::Value = serde_json::from_str(&text).unwrap();
+    assert_eq!(json["shapes"].as_array().unwrap().len(), 2);
+
+    let missing = dir.path().join("missing");
+    job.json = Some(dir.path().join("none.json"));
+    let err = run_eval(&missing, &truth, &job).unwrap_err();
+    assert!(err.to_string().contains("missing"), "{err}");
+    assert!(!dir.path().join("none.json").exists());
+}
