@@ -15,7 +15,9 @@
 //! ```
 //! Common options: `--sources A,B` (chairs: only these single sources), `--triple A,B,C` (only
 //! this set of sources), `--per-target` (accuracy, confusion and label counts of every target
-//! on stderr), `--cache DIR` (default /tmp/coseg-eval-cache), `--size-prior A`,
+//! on stderr), `--cache DIR` (default /tmp/coseg-eval-cache), `--routes all|affinity` (the
+//! library's default fusion of every route, or the band affinity alone; with `all` each route
+//! alone is printed beside the fusion), `--snap-band B`, `--size-prior A`,
 //! `--network-weight W`, `--similarity-power P`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
 //! `--part-score affinity|geometric`, `--area-weighted true|false`, `--refit-rounds N`,
 //! `--refit-weight B`, `--update-relays true|false`;
@@ -42,11 +44,14 @@ use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
 use coseg::labels::{faces_to_vertices, read_label_file};
 use coseg::mesh::{TriMesh, read_mesh};
 use coseg::pipeline::{ShapePipelineOptions, load_or_compute_bands};
-use coseg::propagate::{PartScore, PropagateOptions, propagate_labels};
+use coseg::propagate::{
+    CollectionParts, PartScore, PropagateOptions, RouteOptions, fuse_propagation, propagate_labels,
+};
 use coseg::spectral::HeatSmoother;
 use rand::SeedableRng;
 use rand::seq::SliceRandom;
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::collections::HashMap;
 use std::path::PathBuf;
 use std::sync::Mutex;
@@ -59,6 +64,12 @@ struct Set {
     smoothers: Option<Vec<HeatSmoother>>,
     /// `--route rigid`: registrations `(source, target)` computed so far.
     rigid: Option<Mutex<HashMap<(usize, usize), Registration>>>,
+    /// The routes fused with the band affinity (`--routes affinity`: none) and the
+    /// collection's co-segmentations, made once per number of parts.
+    routes: RouteOptions,
+    parts: Mutex<CollectionParts>,
+    /// Per route (and "fused"), the mean accuracy of every run, in run order.
+    route_log: Mutex<BTreeMap<String, Vec<(usize, f64)>>>,
 }
 
 fn load(
@@ -67,6 +78,7 @@ fn load(
     pipeline: &ShapePipelineOptions,
     graph: &GraphOptions,
     time: f64,
+    routes: &RouteOptions,
 ) -> Result<Set, Box<dyn std::error::Error>> {
     let t = Instant::now();
     let loaded: Vec<(String, TriMesh, ShapeNode)> = files
@@ -88,6 +100,7 @@ fn load(
         nodes.push(node);
     }
     let features = nodes.first().map_or(0, |n| n.bands.features);
+    let parts = CollectionParts::new(nodes.clone(), pipeline, graph, Some(cache.to_path_buf()));
     let mut graph = ShapeGraph::build(nodes, graph)?;
     graph.set_feature_weights(pipeline.feature_weights(features))?;
     let smoothers = if time > 0.0 {
@@ -112,6 +125,9 @@ fn load(
         graph,
         smoothers,
         rigid: None,
+        routes: routes.clone(),
+        parts: Mutex::new(parts),
+        route_log: Mutex::new(BTreeMap::new()),
     })
 }
 
@@ -130,11 +146,62 @@ fn run(
     let ann: Vec<Option<Vec<i32>>> = (0..n)
         .map(|i| sources.contains(&i).then(|| annotation(i)))
         .collect();
-    let p = propagate_labels(&set.graph, set.smoothers.as_deref(), &ann, options)?;
-    Ok((0..n)
-        .filter(|i| !sources.contains(i))
-        .map(|i| (i, score(i, &p.labels[i])))
-        .collect())
+    let mut p = propagate_labels(&set.graph, set.smoothers.as_deref(), &ann, options)?;
+    // The library's default: the band affinity fused with the other routes, as
+    // `propagate_collection` runs it; each route alone is logged beside it.
+    let report = fuse_propagation(
+        &set.graph,
+        &set.meshes,
+        &ann,
+        &mut p,
+        Some(&mut *set.parts.lock().unwrap()),
+        &set.routes,
+    )?;
+    for w in &report.warnings {
+        eprintln!("warning: {w}");
+    }
+    let targets: Vec<usize> = (0..n).filter(|i| !sources.contains(i)).collect();
+    let mut log = set.route_log.lock().unwrap();
+    for (route, labels) in &report.routes {
+        let r: Vec<(usize, f64)> = targets
+            .iter()
+            .filter(|&&i| labels.votes_on(i))
+            .map(|&i| (i, score(i, &labels.labels[i])))
+            .collect();
+        log.entry(route.name().to_string())
+            .or_default()
+            .push((sources[0], mean(&r)));
+    }
+    let fused_unsnapped: Vec<(usize, f64)> = targets
+        .iter()
+        .map(|&i| (i, score(i, &report.fused.labels[i])))
+        .collect();
+    log.entry("fused, votes' boundaries".into())
+        .or_default()
+        .push((sources[0], mean(&fused_unsnapped)));
+    let r: Vec<(usize, f64)> = targets
+        .iter()
+        .map(|&i| (i, score(i, &p.labels[i])))
+        .collect();
+    log.entry("fused (default)".into())
+        .or_default()
+        .push((sources[0], mean(&r)));
+    Ok(r)
+}
+
+/// Prints each logged route's mean over the runs and its worst run, then clears the log.
+fn print_routes(set: &Set, what: &str) {
+    let mut log = set.route_log.lock().unwrap();
+    for (route, runs) in log.iter() {
+        let (w, wv) = worst(runs);
+        println!(
+            "  {what}, {route}: mean {:.2} %, worst {} ({:.1} %)",
+            100.0 * mean(runs),
+            set.names[w],
+            100.0 * wv
+        );
+    }
+    log.clear();
 }
 
 /// The rigid baseline: every target registered onto each source (similarity, any pose), its
@@ -298,6 +365,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut route_rigid = false;
     let mut swaps: Vec<(Vec<String>, i32, i32)> = Vec::new();
     let (mut seg, mut reps): (Option<PathBuf>, usize) = (None, 3);
+    let mut routes = RouteOptions::default();
     while let Some(a) = args.next() {
         let mut val = || args.next().ok_or(format!("{a} needs a value"));
         match a.as_str() {
@@ -335,6 +403,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--seg" => seg = Some(PathBuf::from(val()?)),
             "--reps" => reps = val()?.parse()?,
             "--per-target" => per_target = true,
+            "--routes" => {
+                routes = match val()?.as_str() {
+                    "affinity" => RouteOptions::affinity_only(),
+                    "all" => RouteOptions::default(),
+                    o => return Err(format!("--routes {o}: all or affinity").into()),
+                }
+            }
+            "--snap-band" => routes.snap_band = val()?.parse()?,
             "--triple" => triple = Some(val()?),
             "--sources" => only = Some(val()?.split(',').map(str::to_string).collect()),
             "--features" => features = val()?,
@@ -388,7 +464,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .and_then(|s| s.parse::<u64>().ok())
                     .unwrap_or(u64::MAX)
             });
-            let mut set = load(&files, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let mut set = load(
+                &files,
+                &cache,
+                &pipeline,
+                &graph,
+                options.smoothing_time,
+                &routes,
+            )?;
             if route_rigid {
                 set.rigid = Some(Mutex::default());
             }
@@ -451,7 +534,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // A shipped collection: meshes and `<stem>.labels.txt` (per vertex) in one folder.
             let dir = rest.first().ok_or("labelled DIR")?;
             let files = coseg::graph::mesh_files(dir)?;
-            let mut set = load(&files, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let mut set = load(
+                &files,
+                &cache,
+                &pipeline,
+                &graph,
+                options.smoothing_time,
+                &routes,
+            )?;
             if route_rigid {
                 set.rigid = Some(Mutex::default());
             }
@@ -486,7 +576,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // Timing, warm cache: MESH... (the first two are labelled), `--seg DIR` for face
             // labels by stem (else 6 farthest-point parts of each labelled shape), `--reps N`.
             let t = Instant::now();
-            let set = load(&rest, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let set = load(
+                &rest,
+                &cache,
+                &pipeline,
+                &graph,
+                options.smoothing_time,
+                &routes,
+            )?;
             let t_load = t.elapsed().as_secs_f64();
             let ann = |i: usize| -> Vec<i32> {
                 match &seg {
@@ -502,7 +599,14 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bench(&set, &ann, &options, reps, t_load)
         }
         "identity" => {
-            let mut set = load(&rest, &cache, &pipeline, &graph, options.smoothing_time)?;
+            let mut set = load(
+                &rest,
+                &cache,
+                &pipeline,
+                &graph,
+                options.smoothing_time,
+                &routes,
+            )?;
             if route_rigid {
                 set.rigid = Some(Mutex::default());
             }
@@ -569,6 +673,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 100.0 * wv,
                 t.elapsed().as_secs_f64()
             );
+            print_routes(&set, "one source");
             Ok(())
         }
         _ => Err(format!("unknown mode {mode}").into()),
@@ -638,6 +743,7 @@ fn chairs(
         set.names[ws],
         100.0 * wsv
     );
+    print_routes(set, "one source");
     if set.rigid.is_some() {
         println!("\nincremental: not run (rigid route)");
     } else if let Err(e) = incremental(set, ann, score, options) {
@@ -672,6 +778,7 @@ fn chairs(
         100.0 * mean(&tmeans),
         100.0 * wt
     );
+    print_routes(set, "three sources (worst: the triple's first source)");
     Ok(())
 }
 

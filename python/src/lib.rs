@@ -769,6 +769,7 @@ fn propagate<'py>(
                     // arrays in memory do not run it.
                     map_steps: vec![None; n_shapes],
                     map_step: None,
+                    fusion: solved.fusion,
                     warnings,
                 };
                 Ok((result, loaded.outcomes))

@@ -1,8 +1,8 @@
 //! [`propagate_collection`]: a folder of meshes and its label files in one call.
 
 use super::{
-    MapStepOptions, MapStepReport, PropagateError, PropagateOptions, Propagation, map_step,
-    propagate_labels,
+    CollectionParts, FusionReport, MapStepOptions, MapStepReport, PropagateError, PropagateOptions,
+    Propagation, RouteOptions, fuse_propagation, map_step, propagate_labels,
 };
 use crate::cache::CacheOutcome;
 use crate::graph::{GraphOptions, ShapeGraph, ShapeNode, SkippedFile, load_collection};
@@ -26,6 +26,10 @@ pub struct PropagateCollectionOptions {
     pub graph: GraphOptions,
     /// The solver.
     pub propagate: PropagateOptions,
+    /// The correspondence routes fused with the band-affinity transport, and the boundary
+    /// snapping ([`fuse_propagation`]); default: every route ([`RouteOptions::default`]).
+    /// [`RouteOptions::affinity_only`] gives the transport alone.
+    pub routes: RouteOptions,
     /// Per-shape cache folder (default: `coseg-cache` in the system's temporary folder; the
     /// input folder is never written).
     pub cache_dir: Option<PathBuf>,
@@ -75,6 +79,8 @@ pub struct PropagatedCollection {
     pub map_steps: Vec<Option<MapStepReport>>,
     /// The map step's options when it ran.
     pub map_step: Option<MapStepOptions>,
+    /// Each route's labels and trust ([`fuse_propagation`]).
+    pub fusion: FusionReport,
     /// Warnings for the user.
     pub warnings: Vec<String>,
 }
@@ -106,6 +112,7 @@ pub fn propagate_collection(
     options: &PropagateCollectionOptions,
 ) -> Result<PropagatedCollection, PropagateError> {
     options.propagate.validate()?;
+    options.routes.validate()?;
     let cache = options
         .cache_dir
         .clone()
@@ -157,7 +164,9 @@ pub fn propagate_collection(
         Some(p) => read_part_names(p)?,
         None => PartNames::new(),
     };
-    let mut solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, options)?;
+    let mut with_cache = options.clone();
+    with_cache.cache_dir = Some(cache.clone());
+    let mut solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, &with_cache)?;
     warnings.extend(solved.warnings);
     let map_steps = match &options.map_step {
         Some(ms) => {
@@ -189,6 +198,7 @@ pub fn propagate_collection(
         outcomes: loaded.outcomes,
         map_steps,
         map_step: options.map_step.clone(),
+        fusion: solved.fusion,
         warnings,
     })
 }
@@ -318,7 +328,9 @@ pub struct PropagatedShapes {
     pub smoothers: Vec<HeatSmoother>,
     /// The labels and confidences.
     pub propagation: Propagation,
-    /// Warnings for the user (smoothing turned off).
+    /// Each route's labels and trust ([`fuse_propagation`]).
+    pub fusion: FusionReport,
+    /// Warnings for the user (smoothing turned off, a route left out).
     pub warnings: Vec<String>,
 }
 
@@ -326,8 +338,10 @@ pub struct PropagatedShapes {
 /// stage (from a folder, or from arrays in memory): builds the shape graph of `nodes` under
 /// `options.graph` and one heat smoother per mesh (`meshes[i]` is `nodes[i]`'s; smoothing is
 /// turned off with a warning when one fails), then runs [`propagate_labels`] with
-/// `annotations` (one per node, per-vertex, `< 0` = unlabelled). `options.pipeline` gives only the
-/// families' weights; `options.cache_dir` is not used. The same shapes and annotations give the same labels as
+/// `annotations` (one per node, per-vertex, `< 0` = unlabelled) and fuses it with the other
+/// routes of `options.routes` ([`fuse_propagation`]). `options.pipeline` gives the families'
+/// weights (and the parts route's up direction); `options.cache_dir`, when given, keeps the
+/// shapes' part cues. The same shapes and annotations give the same labels as
 /// [`propagate_collection`] on their files.
 pub fn propagate_loaded(
     nodes: Vec<ShapeNode>,
@@ -336,6 +350,7 @@ pub fn propagate_loaded(
     options: &PropagateCollectionOptions,
 ) -> Result<PropagatedShapes, PropagateError> {
     options.propagate.validate()?;
+    options.routes.validate()?;
     if meshes.len() != nodes.len() {
         return Err(PropagateError::BadOption(format!(
             "{} meshes for {} shapes",
@@ -345,6 +360,14 @@ pub fn propagate_loaded(
     }
     let mut warnings = Vec::new();
     let features = nodes.first().map_or(0, |n| n.bands.features);
+    let mut parts = options.routes.parts.then(|| {
+        CollectionParts::new(
+            nodes.clone(),
+            &options.pipeline,
+            &options.graph,
+            options.cache_dir.clone(),
+        )
+    });
     let mut graph = ShapeGraph::build(nodes, &options.graph)?;
     // The families' shares of the affinity (`--family-weights`), as `coseg segment` uses them.
     graph.set_feature_weights(options.pipeline.feature_weights(features))?;
@@ -365,11 +388,21 @@ pub fn propagate_loaded(
         Vec::new()
     };
     let smooth = (!smoothers.is_empty()).then_some(smoothers.as_slice());
-    let propagation = propagate_labels(&graph, smooth, annotations, &options.propagate)?;
+    let mut propagation = propagate_labels(&graph, smooth, annotations, &options.propagate)?;
+    let fusion = fuse_propagation(
+        &graph,
+        meshes,
+        annotations,
+        &mut propagation,
+        parts.as_mut(),
+        &options.routes,
+    )?;
+    warnings.extend(fusion.warnings.iter().cloned());
     Ok(PropagatedShapes {
         graph,
         smoothers,
         propagation,
+        fusion,
         warnings,
     })
 }

@@ -1,7 +1,12 @@
 //! Label propagation: part labels from a few annotated shapes to a whole collection
 //! (docs/PROPAGATION.md argues the design).
 //!
-//! - [`propagate_labels`]: the solver on a [`ShapeGraph`](crate::graph::ShapeGraph):
+//! - [`propagate_collection`] and [`propagate_loaded`] run, by default, every correspondence
+//!   route and fuse them ([`fuse_propagation`]): the band-affinity transport
+//!   ([`propagate_labels`]), the collection's own parts named from the sources
+//!   ([`parts_route`]); each route is trusted on each shape as far as the others agree with it
+//!   ([`fuse_routes`]) and the fused boundaries move onto concave creases ([`snap_labels`]).
+//! - [`propagate_labels`]: the band-affinity solver on a [`ShapeGraph`](crate::graph::ShapeGraph):
 //!   annotated parts are fixed regions on their sources, transported through the band affinity
 //!   onto every shape, relayed by labelled neighbours over the graph, smoothed and sized.
 //! - [`Propagation::update`]: add or correct one annotation and re-propagate from the previous
@@ -16,18 +21,28 @@
 //!   [`map_step_collection`] runs it on every unlabelled shape of a propagation.
 
 mod collection;
+mod fuse_propagation;
+mod fuse_routes;
 mod map_step;
 mod options;
 mod part_scores;
+mod parts_route;
+mod rigid_route;
+mod snap_labels;
 mod solve;
 
 pub use collection::{
     PropagateCollectionOptions, PropagatedCollection, PropagatedShapes, SourceFile,
     map_step_collection, propagate_collection, propagate_loaded,
 };
+pub use fuse_propagation::{CollectionParts, FusionReport, RouteOptions, fuse_propagation};
+pub use fuse_routes::{FusedRoutes, Route, RouteLabels, fuse_routes};
 pub use map_step::{MapStepOptions, MapStepReport, map_step};
 pub use options::PropagateOptions;
 pub use part_scores::PartScore;
+pub use parts_route::parts_route;
+pub use rigid_route::rigid_route;
+pub use snap_labels::snap_labels;
 pub use solve::{Propagation, UpdateStats, propagate_labels};
 
 use thiserror::Error;

@@ -650,6 +650,22 @@ impl Propagation {
         self.update_stats(graph, i);
     }
 
+    /// [`Propagation::set_labels`] with the labels' own per-vertex confidences (`conf`, one
+    /// per vertex in `[0, 1]`; a vector that does not fit keeps the current ones). Used by the
+    /// fusion of routes.
+    pub(crate) fn set_labels_confidence(
+        &mut self,
+        graph: &ShapeGraph,
+        i: usize,
+        labels: Vec<i32>,
+        conf: Vec<f64>,
+    ) {
+        if conf.len() == self.confidence[i].len() {
+            self.confidence[i] = conf;
+        }
+        self.set_labels(graph, i, labels);
+    }
+
     fn update_stats(&mut self, graph: &ShapeGraph, i: usize) {
         let areas = &graph.node(i).areas;
         let np = self.parts.len();

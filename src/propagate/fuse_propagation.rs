@@ -1,0 +1,205 @@
+//! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
+
+use super::{
+    FusedRoutes, PropagateError, Propagation, Route, RouteLabels, fuse_routes, parts_route,
+    rigid_route, snap_labels,
+};
+use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
+use crate::mesh::TriMesh;
+use crate::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions, segment_collection};
+use crate::pipeline::ShapePipelineOptions;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+/// Which routes [`fuse_propagation`] adds to the band-affinity transport, and how the fused
+/// labels' boundaries are finished. `Default` is `coseg propagate`'s default.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[non_exhaustive]
+pub struct RouteOptions {
+    /// The parts route ([`super::parts_route`]): the collection's co-segmentation as `coseg
+    /// segment --parts K --parts-from geometry` makes it, `K` the number of distinct labels
+    /// on the sources, each part named from the sources. Default `true`; `false` leaves the
+    /// affinity (and the other routes) alone.
+    pub parts: bool,
+    /// The rigid route ([`super::rigid_route`]): each unlabelled shape registered onto the
+    /// sources by a similarity, labels from the nearest surface point. Default `true`.
+    pub rigid: bool,
+    /// How far the fused labels' boundaries may move onto a concave crease, × √(shape area)
+    /// ([`super::snap_labels`]); default [`PartsFrom::GEOMETRY_BAND`] (0.1), the parts'
+    /// own band. `0` keeps the boundaries where the votes cross.
+    pub snap_band: f64,
+}
+
+impl Default for RouteOptions {
+    fn default() -> Self {
+        RouteOptions {
+            parts: true,
+            rigid: true,
+            snap_band: PartsFrom::GEOMETRY_BAND,
+        }
+    }
+}
+
+impl RouteOptions {
+    /// All routes off and no snapping: the band-affinity transport alone, as
+    /// [`super::propagate_labels`] gives it.
+    pub fn affinity_only() -> Self {
+        RouteOptions {
+            parts: false,
+            rigid: false,
+            snap_band: 0.0,
+        }
+    }
+
+    pub(crate) fn validate(&self) -> Result<(), PropagateError> {
+        if !(self.snap_band.is_finite() && self.snap_band >= 0.0) {
+            return Err(PropagateError::BadOption(format!(
+                "snap_band = {} must be finite and non-negative",
+                self.snap_band
+            )));
+        }
+        Ok(())
+    }
+}
+
+/// The collection's co-segmentations for the parts route, made once per number of parts and
+/// kept (a new annotation with the same number of labels reuses them).
+#[derive(Debug, Clone)]
+pub struct CollectionParts {
+    nodes: Vec<ShapeNode>,
+    options: SegmentCollectionOptions,
+    made: BTreeMap<usize, Cosegmentation>,
+}
+
+impl CollectionParts {
+    /// The parts of the shapes `nodes` (graph order) under the per-shape `pipeline` they were
+    /// computed with (its feature weights, up direction and mirror-invariant columns, as
+    /// `coseg segment` uses them) and the shape `graph`'s options; `cue_cache`: where each
+    /// shape's part cues are kept (`None`: computed every run).
+    pub fn new(
+        nodes: Vec<ShapeNode>,
+        pipeline: &ShapePipelineOptions,
+        graph: &GraphOptions,
+        cue_cache: Option<PathBuf>,
+    ) -> Self {
+        let features = nodes.first().map_or(0, |n| n.bands.features);
+        let options = SegmentCollectionOptions {
+            graph: *graph,
+            feature_weights: pipeline.feature_weights(features),
+            up: pipeline.up_direction(),
+            mirror_columns: pipeline.mirror_invariant_columns(features),
+            cue_cache,
+            ..Default::default()
+        };
+        CollectionParts {
+            nodes,
+            options,
+            made: BTreeMap::new(),
+        }
+    }
+
+    /// The co-segmentation into `count` parts of [`PartsFrom::Geometry`] (made on the first
+    /// call for `count`).
+    ///
+    /// Errors: those of [`segment_collection`].
+    pub fn parts(
+        &mut self,
+        count: usize,
+        meshes: &[TriMesh],
+    ) -> Result<&Cosegmentation, GraphError> {
+        if !self.made.contains_key(&count) {
+            let mut o = self.options.clone();
+            o.request_parts(PartsRequest::Count(count), None);
+            o.set_parts_from(
+                PartsFrom::Geometry {
+                    leaves: PartsFrom::GEOMETRY_LEAVES.max(count),
+                    band: PartsFrom::GEOMETRY_BAND,
+                },
+                None,
+            );
+            let s = segment_collection(self.nodes.clone(), meshes, &o)?;
+            self.made.insert(count, s.segmentation);
+        }
+        Ok(&self.made[&count])
+    }
+}
+
+/// What [`fuse_propagation`] did.
+#[derive(Debug, Clone, Default)]
+pub struct FusionReport {
+    /// Each route's own labels, in the order of [`FusedRoutes::weights`].
+    pub routes: Vec<(Route, RouteLabels)>,
+    /// The fused labels (before the boundary snapping) and each route's trust per shape.
+    pub fused: FusedRoutes,
+    /// Optional routes that could not run, for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Fuses the band-affinity `propagation` with the other correspondence routes of `options`
+/// ([`fuse_routes`]) and moves the fused boundaries onto creases ([`snap_labels`]); the fused
+/// labels and their margins replace the unlabelled shapes' labels and confidences in
+/// `propagation` (the sources keep their annotations), so that
+/// [`Propagation::update`] continues from them.
+///
+/// Inputs: `graph`, `meshes` (#shapes, graph order), `annotations` (as given to
+/// [`super::propagate_labels`]), the affinity `propagation` of them, `parts` (the
+/// collection's co-segmentations, reused across calls; `None` skips the parts route).
+/// Output: the [`FusionReport`]. An optional route that fails (its co-segmentation cannot be
+/// made) is left out with a warning.
+///
+/// Errors: [`PropagateError::BadOption`] for invalid options or inputs that do not fit.
+pub fn fuse_propagation(
+    graph: &ShapeGraph,
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    propagation: &mut Propagation,
+    parts: Option<&mut CollectionParts>,
+    options: &RouteOptions,
+) -> Result<FusionReport, PropagateError> {
+    options.validate()?;
+    let n = graph.node_count();
+    if meshes.len() != n || annotations.len() != n {
+        return Err(PropagateError::BadOption(format!(
+            "{} meshes and {} annotations for {n} shapes",
+            meshes.len(),
+            annotations.len()
+        )));
+    }
+    let areas: Vec<&[f64]> = (0..n).map(|i| graph.node(i).areas.as_slice()).collect();
+    let mut report = FusionReport::default();
+    let mut affinity = RouteLabels::empty(n);
+    for i in (0..n).filter(|&i| annotations[i].is_none()) {
+        affinity.labels[i] = propagation.labels[i].clone();
+        affinity.confidence[i] = propagation.confidence[i].clone();
+        affinity.shape_confidence[i] = propagation.shape_confidence[i];
+    }
+    report.routes.push((Route::Affinity, affinity));
+    if let (true, Some(parts)) = (options.parts, parts) {
+        let count = propagation.parts.len();
+        match parts.parts(count, meshes) {
+            Ok(seg) => report
+                .routes
+                .push((Route::Parts, parts_route(seg, annotations, &areas))),
+            Err(e) => report
+                .warnings
+                .push(format!("parts route off: the co-segmentation failed: {e}")),
+        }
+    }
+    if options.rigid {
+        let (rigid, warnings) = rigid_route(meshes, annotations);
+        report.warnings.extend(warnings);
+        report.routes.push((Route::Rigid, rigid));
+    }
+    let refs: Vec<&RouteLabels> = report.routes.iter().map(|(_, r)| r).collect();
+    report.fused = fuse_routes(&refs, &areas);
+    let snapped = snap_labels(meshes, &report.fused.labels, options.snap_band)?;
+    for (i, labels) in snapped.into_iter().enumerate() {
+        if annotations[i].is_some() || labels.is_empty() {
+            continue;
+        }
+        let conf = report.fused.confidence[i].clone();
+        propagation.set_labels_confidence(graph, i, labels, conf);
+    }
+    Ok(report)
+}

@@ -1,0 +1,142 @@
+//! The fusion of correspondence routes (`coseg::propagate::{fuse_routes, parts_route,
+//! snap_labels}`) on synthetic votes.
+
+use coseg::graph::{Cosegmentation, RegionTuple};
+use coseg::propagate::{RouteLabels, fuse_routes, parts_route};
+use rand::{RngExt, SeedableRng};
+
+/// Route labels on shape 1 of two (shape 0 a source): `labels` with confidence `conf`.
+fn route(labels: Vec<i32>, conf: f64) -> RouteLabels {
+    let d = labels.len();
+    let mut r = RouteLabels::empty(2);
+    r.labels[1] = labels;
+    r.confidence[1] = vec![conf; d];
+    r
+}
+
+/// The truth `0..3` in thirds of `d` vertices, and a copy of it corrupted on a seeded random
+/// share `wrong` of the vertices (each given another label at random).
+fn truth_and_noisy(d: usize, wrong: f64, seed: u64) -> (Vec<i32>, Vec<i32>) {
+    let truth: Vec<i32> = (0..d).map(|v| (3 * v / d) as i32).collect();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
+    let noisy = truth
+        .iter()
+        .map(|&l| {
+            if rng.random::<f64>() < wrong {
+                (l + rng.random_range(1..3)) % 3
+            } else {
+                l
+            }
+        })
+        .collect();
+    (truth, noisy)
+}
+
+fn accuracy(a: &[i32], b: &[i32]) -> f64 {
+    a.iter().zip(b).filter(|(x, y)| x == y).count() as f64 / a.len() as f64
+}
+
+#[test]
+fn the_route_the_others_agree_with_wins_where_it_is_outvoted() {
+    // Route A is right everywhere; B and C are each wrong on 40 % of the vertices,
+    // independently. Where B and C agree on a wrong label they outvote A in a plain
+    // majority; their agreement with A (each 60 %) exceeds their agreement with each other
+    // (about 40 %), so A's estimated accuracy is the highest and its vote carries.
+    let d = 3000;
+    let (truth, b) = truth_and_noisy(d, 0.4, 1);
+    let (_, c) = truth_and_noisy(d, 0.4, 2);
+    let routes = [
+        route(b.clone(), 0.5),
+        route(truth.clone(), 0.5),
+        route(c, 0.5),
+    ];
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas = [vec![1.0; 10], vec![1.0; d]];
+    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
+    let fused = fuse_routes(&refs, &area_refs);
+    assert_eq!(
+        fused.labels[0],
+        Vec::<i32>::new(),
+        "the source is not fused"
+    );
+    let acc = accuracy(&fused.labels[1], &truth);
+    assert!(acc > 0.999, "fused accuracy {acc}");
+    let w = &fused.weights[1];
+    assert!(w[1] > w[0] && w[1] > w[2], "weights {w:?}");
+    // A plain majority would have taken the wrong label wherever B and C agree on one.
+    let majority_wrong = (0..d)
+        .filter(|&v| b[v] != truth[v] && b[v] == routes[2].labels[1][v])
+        .count();
+    assert!(majority_wrong > 0);
+}
+
+#[test]
+fn a_collapsed_route_loses_its_say() {
+    // Two routes nearly right (5 % noise each), one that says one label everywhere (a rigid
+    // alignment that collapsed): the fused labels are the good routes' and the collapsed
+    // route's weight is the smallest.
+    let d = 2000;
+    let (truth, a) = truth_and_noisy(d, 0.05, 3);
+    let (_, b) = truth_and_noisy(d, 0.05, 4);
+    let routes = [route(a, 1.0), route(vec![2; d], 1.0), route(b, 1.0)];
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas = [vec![1.0; 4], vec![1.0; d]];
+    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
+    let fused = fuse_routes(&refs, &area_refs);
+    let acc = accuracy(&fused.labels[1], &truth);
+    assert!(acc > 0.99, "fused accuracy {acc}");
+    let w = &fused.weights[1];
+    assert!(w[1] <= w[0] && w[1] <= w[2], "weights {w:?}");
+}
+
+#[test]
+fn fusion_is_deterministic_and_in_range() {
+    let d = 500;
+    let (_, a) = truth_and_noisy(d, 0.2, 5);
+    let (_, b) = truth_and_noisy(d, 0.3, 6);
+    let (_, c) = truth_and_noisy(d, 0.1, 7);
+    let routes = [route(a, 0.3), route(b, 0.9), route(c, 0.6)];
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas: [Vec<f64>; 2] = [vec![1.0; 3], (0..d).map(|v| 1.0 + (v % 7) as f64).collect()];
+    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
+    let first = fuse_routes(&refs, &area_refs);
+    let second = fuse_routes(&refs, &area_refs);
+    assert_eq!(first, second);
+    assert!(first.confidence[1].iter().all(|c| (0.0..=1.0).contains(c)));
+    assert!(first.agreement[1].iter().all(|a| (0.0..=1.0).contains(a)));
+}
+
+#[test]
+fn parts_are_named_by_the_sources_majority_and_unknown_parts_say_so() {
+    // Two shapes of 6 vertices, three tuples: {0,1}, {2,3}, {4,5} on both. The source
+    // labels tuple 0 as 7 (one vertex 8), tuple 1 as 9, and leaves tuple 2 unlabelled.
+    let tuple = |a: u32, b: u32| RegionTuple {
+        regions: vec![vec![a, b], vec![a, b]],
+        area_fractions: vec![1.0 / 3.0; 2],
+        sweeps: 0,
+        converged: true,
+        cycled: false,
+        objective: 0.0,
+        confidence: 1.0,
+        cycle_consistency: None,
+        leftover: false,
+    };
+    let seg = Cosegmentation {
+        names: vec!["s".into(), "t".into()],
+        vertices: vec![6, 6],
+        root: 0,
+        order: vec![0, 1],
+        parent: vec![None, Some(0)],
+        alpha: 1.0 / 3.0,
+        tuples: vec![tuple(0, 1), tuple(2, 3), tuple(4, 5)],
+    };
+    let areas = [vec![1.0, 3.0, 1.0, 1.0, 1.0, 1.0], vec![1.0; 6]];
+    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
+    let ann = vec![Some(vec![8, 7, 9, 9, -1, -1]), None];
+    let r = parts_route(&seg, &ann, &area_refs);
+    assert!(r.labels[0].is_empty());
+    assert_eq!(r.labels[1], vec![7, 7, 9, 9, -1, -1]);
+    // Tuple 0: label 7 holds 3 of its 4 units of area.
+    assert_eq!(r.confidence[1][..4], [0.75, 0.75, 1.0, 1.0]);
+    assert_eq!(r.confidence[1][4], 0.0);
+}
