@@ -1,6 +1,8 @@
 //! The fusion of correspondence routes (`coseg::propagate::{fuse_routes, parts_route,
 //! snap_labels}`) on synthetic votes.
 
+mod common;
+
 use coseg::graph::{Cosegmentation, RegionTuple};
 use coseg::propagate::{RouteLabels, fuse_routes, parts_route};
 use rand::{RngExt, SeedableRng};
@@ -83,10 +85,13 @@ fn a_collapsed_route_loses_its_say() {
     let areas = [vec![1.0; 4], vec![1.0; d]];
     let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
     let fused = fuse_routes(&refs, &area_refs);
+    // Where the two good routes disagree (about 10 % of the vertices) nothing tells which
+    // is right: about half of those are lost, as by any vote.
     let acc = accuracy(&fused.labels[1], &truth);
-    assert!(acc > 0.99, "fused accuracy {acc}");
+    assert!(acc > 0.93, "fused accuracy {acc}");
     let w = &fused.weights[1];
-    assert!(w[1] <= w[0] && w[1] <= w[2], "weights {w:?}");
+    assert!(w[1] < w[0] && w[1] < w[2], "weights {w:?}");
+    assert!(w[1].abs() < 1e-9, "a route at chance has no say: {w:?}");
 }
 
 #[test]
@@ -139,4 +144,70 @@ fn parts_are_named_by_the_sources_majority_and_unknown_parts_say_so() {
     // Tuple 0: label 7 holds 3 of its 4 units of area.
     assert_eq!(r.confidence[1][..4], [0.75, 0.75, 1.0, 1.0]);
     assert_eq!(r.confidence[1][4], 0.0);
+}
+
+/// Regression: on vertex-permuted copies of one smooth blob (no creases), the default fusion
+/// must give the copies the source's labels (the rigid route overlays them exactly), not move
+/// the boundaries onto creases that are not there.
+#[test]
+fn identical_copies_keep_the_sources_labels_under_the_default_fusion() {
+    use common::features::{blob, permutation, permute_mesh};
+    use coseg::evaluate::vertex_label_agreement;
+    use coseg::propagate::{PropagateCollectionOptions, RouteOptions, propagate_collection};
+    let dir = tempfile::tempdir().unwrap();
+    let shapes = dir.path().join("shapes");
+    std::fs::create_dir(&shapes).unwrap();
+    let mesh = blob(3);
+    let slab = |x: f64| {
+        if x < -0.4 {
+            0
+        } else if x < 0.35 {
+            1
+        } else {
+            2
+        }
+    };
+    let truth_of = |m: &coseg::mesh::TriMesh| -> Vec<i32> {
+        m.positions().iter().map(|p| slab(p[0])).collect()
+    };
+    coseg::mesh::write_mesh(shapes.join("a.off"), &mesh, &[]).unwrap();
+    coseg::labels::write_vertex_labels(dir.path(), "a", &truth_of(&mesh)).unwrap();
+    let mut copies = Vec::new();
+    for (k, seed) in [(1, 11u64), (2, 12)] {
+        let copy = permute_mesh(&mesh, &permutation(mesh.vertex_count(), seed));
+        coseg::mesh::write_mesh(shapes.join(format!("c{k}.off")), &copy, &[]).unwrap();
+        copies.push(copy);
+    }
+    for (what, routes) in [
+        ("default", RouteOptions::default()),
+        ("affinity", RouteOptions::affinity_only()),
+    ] {
+        let mut o = PropagateCollectionOptions::default();
+        o.pipeline.spectrum.eigenpairs = 40;
+        o.cache_dir = Some(dir.path().join("cache"));
+        o.routes = routes;
+        let r = propagate_collection(&shapes, &[dir.path().join("a.labels.txt")], &o).unwrap();
+        for (k, copy) in copies.iter().enumerate() {
+            let i = k + 1;
+            let acc = |l: &[i32]| {
+                vertex_label_agreement(copy, &truth_of(copy), l)
+                    .unwrap()
+                    .accuracy
+            };
+            let routes: Vec<String> = r
+                .fusion
+                .routes
+                .iter()
+                .map(|(route, l)| format!("{} {:.3}", route.name(), acc(&l.labels[i])))
+                .collect();
+            let fin = acc(&r.propagation.labels[i]);
+            eprintln!(
+                "{what}: c{i}: final {fin:.3}, {routes:?}, weights {:?}",
+                r.fusion.fused.weights[i]
+            );
+            // Affinity alone: 0.927 at 0.1.0; the rigid route overlays the copies exactly.
+            let floor = if what == "affinity" { 0.9 } else { 0.97 };
+            assert!(fin >= floor, "{what}: c{i}: {fin}");
+        }
+    }
 }

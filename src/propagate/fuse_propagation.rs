@@ -26,8 +26,11 @@ pub struct RouteOptions {
     /// sources by a similarity, labels from the nearest surface point. Default `true`.
     pub rigid: bool,
     /// How far the fused labels' boundaries may move onto a concave crease, × √(shape area)
-    /// ([`super::snap_labels`]); default [`PartsFrom::GEOMETRY_BAND`] (0.1), the parts'
-    /// own band. `0` keeps the boundaries where the votes cross.
+    /// ([`super::snap_labels`]; [`PartsFrom::GEOMETRY_BAND`], 0.1, is the parts' own band).
+    /// Default `0`: the boundaries stay where the votes cross. The minimum cut moves a
+    /// boundary wherever a crease-free surface offers a shorter cut (permuted copies of a
+    /// smooth blob: 98.1 % fused, 74.7 % snapped; tests/propagate_fusion.rs), so it is
+    /// not a default until it can tell a crease from none.
     pub snap_band: f64,
 }
 
@@ -36,7 +39,7 @@ impl Default for RouteOptions {
         RouteOptions {
             parts: true,
             rigid: true,
-            snap_band: PartsFrom::GEOMETRY_BAND,
+            snap_band: 0.0,
         }
     }
 }

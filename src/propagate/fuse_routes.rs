@@ -261,7 +261,23 @@ fn route_weights(voting: &[usize], kappa: &[Vec<f64>], labels: usize) -> Vec<f64
                     count += 1;
                 }
             }
-            let k = if count > 0 { sum / count as f64 } else { 0.0 };
+            let k = if count > 0 {
+                sum / count as f64
+            } else {
+                // No triangle informs on x (every pair of the others agrees at chance: one
+                // of them collapsed). Read x off the routes it agrees with as if each pair
+                // were equally accurate, `κ_x = √κ_xy` (the two-route case), so that a
+                // collapsed route, agreeing with none, keeps no say.
+                let pairs: Vec<f64> = (0..m)
+                    .filter(|&y| y != x && kappa[x][y] > 0.0)
+                    .map(|y| kappa[x][y].sqrt())
+                    .collect();
+                if pairs.is_empty() {
+                    0.0
+                } else {
+                    pairs.iter().sum::<f64>() / pairs.len() as f64
+                }
+            };
             let k = k.clamp(0.0, MAX_KAPPA);
             let p = 1.0 / l + k * (1.0 - 1.0 / l);
             (p * (l - 1.0) / (1.0 - p)).ln()
