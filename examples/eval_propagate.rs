@@ -17,7 +17,8 @@
 //! this set of sources), `--per-target` (accuracy, confusion and label counts of every target
 //! on stderr), `--cache DIR` (default /tmp/coseg-eval-cache), `--routes all|affinity` (the
 //! library's default fusion of every route, or the band affinity alone; with `all` each route
-//! alone is printed beside the fusion), `--snap-band B`, `--size-prior A`,
+//! alone is printed beside the fusion), `--snap-band B`, `--affine true|false` (the rigid
+//! route's affine relaxation), `--size-prior A`,
 //! `--network-weight W`, `--similarity-power P`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
 //! `--part-score affinity|geometric`, `--area-weighted true|false`, `--refit-rounds N`,
 //! `--refit-weight B`, `--update-relays true|false`;
@@ -411,6 +412,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
             }
             "--snap-band" => routes.snap_band = val()?.parse()?,
+            "--affine" => routes.affine = val()?.parse()?,
             "--triple" => triple = Some(val()?),
             "--sources" => only = Some(val()?.split(',').map(str::to_string).collect()),
             "--features" => features = val()?,

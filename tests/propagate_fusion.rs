@@ -1,5 +1,5 @@
 //! The fusion of correspondence routes (`coseg::propagate::{fuse_routes, parts_route,
-//! snap_labels}`) on synthetic votes.
+//! snap_labels, refine_affine}`) on synthetic votes and shapes.
 
 mod common;
 
@@ -208,6 +208,52 @@ fn identical_copies_keep_the_sources_labels_under_the_default_fusion() {
             // Affinity alone: 0.927 at 0.1.0; the rigid route overlays the copies exactly.
             let floor = if what == "affinity" { 0.9 } else { 0.97 };
             assert!(fin >= floor, "{what}: c{i}: {fin}");
+        }
+    }
+}
+
+/// The rigid route's affine relaxation: a copy of a blob stretched along two axes (other
+/// proportions, as a taller chair) and moved is overlaid vertex on vertex far better than by the
+/// similarity it starts from, and an exact moved copy stays exact.
+#[test]
+fn refine_affine_overlays_a_stretched_copy_that_a_similarity_cannot() {
+    use common::features::{blob, similarity};
+    use coseg::align::{RegisterOptions, SurfaceIndex, register_pair};
+    use coseg::propagate::refine_affine;
+    let source = blob(3);
+    let index = SurfaceIndex::new(&source);
+    let stretched = source
+        .map_positions(|p| [1.35 * p[0], p[1], 0.8 * p[2]])
+        .unwrap();
+    // Mean distance of each mapped target vertex from its own source vertex (same order).
+    let error = |target: &coseg::mesh::TriMesh, map: &dyn Fn([f64; 3]) -> [f64; 3]| {
+        let (s, t) = (source.positions(), target.positions());
+        s.iter()
+            .zip(t)
+            .map(|(a, &b)| {
+                let m = map(b);
+                (0..3).map(|k| (m[k] - a[k]).powi(2)).sum::<f64>().sqrt()
+            })
+            .sum::<f64>()
+            / s.len() as f64
+    };
+    for (what, target) in [
+        ("moved copy", similarity(&source, 2.0)),
+        ("stretched copy", similarity(&stretched, 2.0)),
+    ] {
+        let reg = register_pair(&source, &target, &RegisterOptions::default()).unwrap();
+        let fit = refine_affine(&source, &index, &target, &reg.transform, 0.9);
+        let before = error(&target, &|p| reg.transform.apply(p));
+        let after = error(&target, &|p| fit.map.apply(p));
+        eprintln!(
+            "{what}: residual {:.4} -> {:.4}, vertex error {before:.4} -> {after:.4}",
+            fit.start_residual, fit.residual
+        );
+        assert!(fit.residual <= fit.start_residual, "{what}");
+        if what == "moved copy" {
+            assert!(after < 0.01, "{what}: {after}");
+        } else {
+            assert!(after < 0.5 * before, "{what}: {before} -> {after}");
         }
     }
 }

@@ -32,6 +32,9 @@ pub struct RouteOptions {
     /// smooth blob: 98.1 % fused, 74.7 % snapped; tests/propagate_fusion.rs), so it is
     /// not a default until it can tell a crease from none.
     pub snap_band: f64,
+    /// Whether the rigid route relaxes its similarity to an affine map before reading the
+    /// labels ([`super::refine_affine`]). Default `true`.
+    pub affine: bool,
 }
 
 impl Default for RouteOptions {
@@ -40,6 +43,7 @@ impl Default for RouteOptions {
             parts: true,
             rigid: true,
             snap_band: 0.0,
+            affine: true,
         }
     }
 }
@@ -52,6 +56,7 @@ impl RouteOptions {
             parts: false,
             rigid: false,
             snap_band: 0.0,
+            affine: true,
         }
     }
 
@@ -190,7 +195,7 @@ pub fn fuse_propagation(
         }
     }
     if options.rigid {
-        let (rigid, warnings) = rigid_route(meshes, annotations);
+        let (rigid, warnings) = rigid_route(meshes, annotations, options.affine);
         report.warnings.extend(warnings);
         report.routes.push((Route::Rigid, rigid));
     }

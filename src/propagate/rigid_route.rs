@@ -2,7 +2,10 @@
 //! surface point.
 
 use super::RouteLabels;
-use crate::align::{RegisterOptions, nearest_point_vertex_labels, register_pair};
+use super::refine_affine::refine_affine;
+use crate::align::{
+    RegisterOptions, Similarity, SurfaceIndex, nearest_point_vertex_labels, register_pair,
+};
 use crate::mesh::TriMesh;
 use rayon::prelude::*;
 
@@ -16,8 +19,12 @@ use rayon::prelude::*;
 /// ρ)`, `d` the distance, `ρ` the registration's residual in the same units), so a limb that
 /// the alignment leaves in the air votes weakly; per shape: the registration's inlier share.
 ///
+/// With `affine`, the chosen similarity is then relaxed to an affine map
+/// ([`super::refine_affine`]) before the labels are read, so that a shape of other proportions
+/// (a taller back, a wider seat) overlays its source part on part.
+///
 /// Inputs: `meshes` (#shapes, graph order), `annotations` (one per shape, `Some` per-vertex
-/// labels on the sources). Output: [`RouteLabels`] (empty on the sources) and, per shape that
+/// labels on the sources), `affine`. Output: [`RouteLabels`] (empty on the sources) and, per shape that
 /// could not be registered onto any source, a warning.
 ///
 /// See also: [`crate::align::register_pair`], [`super::fuse_routes`].
@@ -27,6 +34,7 @@ use rayon::prelude::*;
 pub fn rigid_route(
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
+    affine: bool,
 ) -> (RouteLabels, Vec<String>) {
     let n = meshes.len();
     let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
@@ -54,8 +62,30 @@ pub fn rigid_route(
                 return Some(Err(error));
             };
             let ann = annotations[s].as_deref().unwrap_or_default();
-            Some(
+            let carried = if affine {
+                let fit = refine_affine(
+                    &meshes[s],
+                    &SurfaceIndex::new(&meshes[s]),
+                    &meshes[i],
+                    &reg.transform,
+                    AFFINE_TRIM,
+                );
+                match meshes[i].map_positions(|p| fit.map.apply(p)) {
+                    Ok(mapped) => nearest_point_vertex_labels(
+                        &meshes[s],
+                        ann,
+                        &mapped,
+                        &Similarity::identity(),
+                    ),
+                    Err(_) => {
+                        nearest_point_vertex_labels(&meshes[s], ann, &meshes[i], &reg.transform)
+                    }
+                }
+            } else {
                 nearest_point_vertex_labels(&meshes[s], ann, &meshes[i], &reg.transform)
+            };
+            Some(
+                carried
                     .map(|(labels, dist)| {
                         // The residual is in source RMS radii; the distances in source units.
                         let scale = rms_radius(&meshes[s]) * reg.residual.max(f64::EPSILON);
@@ -81,6 +111,11 @@ pub fn rigid_route(
     }
     (out, warnings)
 }
+
+/// Share of the nearest-point pairs (by area, each direction) the affine fit keeps: the
+/// farthest tenth is taken for parts one shape has and the other lacks (an armrest, a
+/// stretcher), which would otherwise pull the fit off the parts both share.
+const AFFINE_TRIM: f64 = 0.9;
 
 /// Root mean square distance of a mesh's vertices from their area-weighted centroid.
 fn rms_radius(mesh: &TriMesh) -> f64 {
