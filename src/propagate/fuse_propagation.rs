@@ -145,9 +145,9 @@ pub struct FusionReport {
 }
 
 /// Fuses the band-affinity `propagation` with the other correspondence routes of `options`
-/// ([`fuse_routes`]) and moves the fused boundaries onto creases ([`snap_labels`]); the fused
-/// labels and their margins replace the unlabelled shapes' labels and confidences in
-/// `propagation` (the sources keep their annotations), so that
+/// ([`fuse_routes`]) and, with a `snap_band` above 0, moves the fused boundaries onto
+/// creases ([`snap_labels`]); the fused labels and their margins replace the unlabelled
+/// shapes' labels and confidences in `propagation` (the sources keep their annotations), so that
 /// [`Propagation::update`] continues from them.
 ///
 /// Inputs: `graph`, `meshes` (#shapes, graph order), `annotations` (as given to
