@@ -330,6 +330,10 @@ pub struct PropagatedShapes {
     pub propagation: Propagation,
     /// Each route's labels and trust ([`fuse_propagation`]).
     pub fusion: FusionReport,
+    /// The collection's co-segmentations made for the parts route (`None` when the route is
+    /// off), kept so that a caller fusing again after [`Propagation::update`] does not make
+    /// them again.
+    pub parts: Option<CollectionParts>,
     /// Warnings for the user (smoothing turned off, a route left out).
     pub warnings: Vec<String>,
 }
@@ -403,6 +407,7 @@ pub fn propagate_loaded(
         smoothers,
         propagation,
         fusion,
+        parts,
         warnings,
     })
 }

@@ -5,7 +5,8 @@ use crate::graph::{ShapeGraph, ShapeNode, load_collection};
 use crate::labels::{read_part_names, read_shape_labels, vertices_to_faces};
 use crate::mesh::{TriMesh, write_atomic};
 use crate::propagate::{
-    PropagateCollectionOptions, Propagation, propagate_labels, propagate_loaded,
+    CollectionParts, PropagateCollectionOptions, Propagation, fuse_propagation, propagate_labels,
+    propagate_loaded,
 };
 use crate::render::{RgbImage, ViewFrame, canonical_frame, draw_mesh, encode_png};
 use crate::spectral::HeatSmoother;
@@ -103,6 +104,9 @@ struct Solved {
     graph: ShapeGraph,
     smoothers: Vec<HeatSmoother>,
     propagation: Propagation,
+    /// The parts route's co-segmentations ([`crate::propagate::PropagatedShapes::parts`]), reused by each
+    /// fusion after an update.
+    parts: Option<CollectionParts>,
 }
 
 /// `summary.json` of a saved session.
@@ -589,6 +593,7 @@ impl Studio {
                     total: changed.len(),
                 });
             }
+            report.warnings = self.fuse_routes()?;
         } else {
             report.full = true;
             match self.solved.as_mut() {
@@ -600,6 +605,7 @@ impl Studio {
                         &self.annotations,
                         &self.options.propagate,
                     )?;
+                    report.warnings = self.fuse_routes()?;
                 }
                 None => {
                     let nodes = self.nodes.clone().expect("nodes kept until the first run");
@@ -611,6 +617,7 @@ impl Studio {
                         graph: out.graph,
                         smoothers: out.smoothers,
                         propagation: out.propagation,
+                        parts: out.parts,
                     });
                 }
             }
@@ -632,6 +639,25 @@ impl Studio {
         self.dirty.clear();
         self.warnings.extend(report.warnings.iter().cloned());
         Ok(report)
+    }
+
+    /// Fuses the band-affinity labels of the last update or solve with the other routes, as
+    /// [`propagate_loaded`] does after its solve ([`fuse_propagation`]), so that a session's
+    /// labels after an update are those `coseg propagate` gives (the update itself moves the
+    /// band affinity alone). Returns the routes' warnings.
+    fn fuse_routes(&mut self) -> Result<Vec<String>, StudioError> {
+        let Some(s) = self.solved.as_mut() else {
+            return Ok(Vec::new());
+        };
+        let fusion = fuse_propagation(
+            &s.graph,
+            &self.meshes,
+            &self.annotations,
+            &mut s.propagation,
+            s.parts.as_mut(),
+            &self.options.routes,
+        )?;
+        Ok(fusion.warnings)
     }
 
     /// Writes the session into the labels folder (created if missing), each file atomically:
