@@ -123,20 +123,46 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
         .zip(&truth)
         .map(|(s, t)| s.transform.compose(t))
         .collect();
+    // With an axis of revolution `a` (collection frame), rotations about it are forgiven:
+    // each shape is then judged by where its net rotation takes `a` from (`netᵀ a`, the
+    // file-frame axis), which a turn about `a` does not change.
+    let plain_error = |x: &Similarity, c: &Similarity| match a.symmetry_axis {
+        None => x.rotation_angle_to(c),
+        Some(axis) => {
+            let back = |s: &Similarity| -> [f64; 3] {
+                std::array::from_fn(|j| (0..3).map(|i| s.rotation[i][j] * axis[i]).sum())
+            };
+            let (u, v) = (back(x), back(c));
+            let dot: f64 = (0..3).map(|k| u[k] * v[k]).sum();
+            dot.clamp(-1.0, 1.0).acos().to_degrees()
+        }
+    };
+    // A shape's own symmetries (`T`, collection frame) are forgiven too: `T ∘ net` is as right.
+    let error_of = |i: usize, c: &Similarity| {
+        a.shapes[i]
+            .symmetries
+            .iter()
+            .map(|t| {
+                let turn = Similarity {
+                    rotation: *t,
+                    scale: 1.0,
+                    translation: [0.0; 3],
+                };
+                plain_error(&turn.compose(&net[i]), c)
+            })
+            .fold(plain_error(&net[i], c), f64::min)
+    };
     // The common frame: the shapes' net rotation that most others are within 5° of, refined
     // by the chordal mean of those.
-    let support = |c: &Similarity| net.iter().filter(|s| s.rotation_angle_to(c) <= 5.0).count();
+    let support = |c: &Similarity| (0..net.len()).filter(|&i| error_of(i, c) <= 5.0).count();
     let seed_frame = net
         .iter()
         .max_by_key(|c| support(c))
         .copied()
         .unwrap_or_else(Similarity::identity);
     let mut m = [[0.0; 3]; 3];
-    for s in net
-        .iter()
-        .filter(|s| s.rotation_angle_to(&seed_frame) <= 5.0)
-    {
-        for (row, r) in m.iter_mut().zip(&s.rotation) {
+    for i in (0..net.len()).filter(|&i| plain_error(&net[i], &seed_frame) <= 5.0) {
+        for (row, r) in m.iter_mut().zip(&net[i].rotation) {
             for (x, y) in row.iter_mut().zip(r) {
                 *x += y;
             }
@@ -144,11 +170,12 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     }
     let mean = nearest_rotation(m);
     let mut within = 0;
-    for ((f, s), sh) in files.iter().zip(&net).zip(&a.shapes) {
-        let e = s.rotation_angle_to(&mean);
+    for (i, (f, sh)) in files.iter().zip(&a.shapes).enumerate() {
+        let e = error_of(i, &mean);
         within += usize::from(e <= 5.0);
         println!(
-            "{f}\terror {e:.1}°\tconfidence {:.2}\tresidual {}\tambiguity {}",
+            "{f}\terror {e:.1}° (own symmetries {})\tconfidence {:.2}\tresidual {}\tambiguity {}",
+            sh.symmetries.len(),
             sh.confidence,
             sh.residual.map_or("-".into(), |r| format!("{r:.4}")),
             sh.ambiguity
@@ -157,13 +184,15 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     println!(
-        "{:?}: {} shapes ({vertices} vertices), {} edges, given-frame share {:.2}, up {:?}, forward {:?}; within 5° of the common frame: {within} of {} ({:.1} %); {wall:.2} s wall ({:.3} s per shape)",
+        "{:?}: {} shapes ({vertices} vertices), {} edges, given-frame share {:.2}, up {:?}, forward {:?}, axis of revolution (forgiven) {:?}; within 5° of the common frame: {within} of {} ({:.1} %); {wall:.2} s wall ({:.3} s per shape)",
         a.case,
         meshes.len(),
         a.edges.len(),
         a.given_frame_share,
         a.up.map(|x| (x * 1000.0).round() / 1000.0),
         a.forward.map(|x| (x * 1000.0).round() / 1000.0),
+        a.symmetry_axis
+            .map(|v| v.map(|x| (x * 1000.0).round() / 1000.0)),
         meshes.len(),
         100.0 * within as f64 / meshes.len() as f64,
         wall / meshes.len() as f64

@@ -2,9 +2,11 @@
 //! over a shape graph.
 
 use super::AlignError;
-use super::register_pair::{RegisterOptions, register_prepared};
+use super::register_pair::COARSE_ITERATIONS;
+use super::register_pair::{Pose, RegisterOptions, icp, signed_permutations};
 use super::similarity::{Similarity, rotation_angle};
-use super::surface_samples::Prepared;
+use super::surface_samples::COARSE_SAMPLES;
+use super::surface_samples::{PointIndex, Prepared};
 use crate::mesh::TriMesh;
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
@@ -62,6 +64,12 @@ pub struct ShapeAlignment {
     pub ambiguity: Option<f64>,
     /// The angle (degrees) of [`ShapeAlignment::ambiguity`]'s pose from the chosen one.
     pub ambiguity_angle: Option<f64>,
+    /// The shape's own symmetries: rotations (row-major, in the collection frame, about the
+    /// shape's centre) that overlay the shape on itself within sampling — a stool turned a
+    /// quarter, a table turned a half. The alignment cannot tell these poses apart: composing
+    /// the transform with one of them is as right. Empty for most shapes.
+    #[serde(default)]
+    pub symmetries: Vec<[[f64; 3]; 3]>,
 }
 
 /// The result of [`align_collection`].
@@ -77,11 +85,18 @@ pub struct CollectionAlignment {
     /// The collection frame's forward axis, a unit vector orthogonal to `up` (`[0, 0, 1]`
     /// when synchronised).
     pub forward: [f64; 3],
-    /// Share of the registration graph's edges whose best pose is the given frame (within 20°):
-    /// the evidence for [`FrameCase::AlreadyAligned`] (at least one half).
+    /// Share of the registration graph's edges that agree with the given frames (their best
+    /// pose is the given one within 20°, up to the target's own symmetries, or ICP from the
+    /// given frames stays there and fits within 5 % of the best): the evidence for [`FrameCase::AlreadyAligned`] (at least one half).
     pub given_frame_share: f64,
     /// Registration-graph edges `(source, target)`, as registered.
     pub edges: Vec<(usize, usize)>,
+    /// The collection's axis of revolution (a unit vector, in the frame of
+    /// [`CollectionAlignment::up`]) when its shapes are surfaces of revolution about one axis
+    /// (goblets, vases): rotations about it fit equally well, so the transforms leave them
+    /// undetermined. `None` otherwise.
+    #[serde(default)]
+    pub symmetry_axis: Option<[f64; 3]>,
 }
 
 /// Poses within this angle (degrees) are one pose: ICP from different starts into one minimum
@@ -90,6 +105,16 @@ const SAME_POSE_DEGREES: f64 = 20.0;
 /// Bins of the D2 descriptor (distances between sample pairs, in RMS radii, over `[0, 4)`):
 /// enough to tell a chair from a table; coarse enough to be stable under resampling.
 const D2_BINS: usize = 32;
+/// The given frames fit an edge "about as well as its best pose" within this share of the
+/// best residual: two coarse registrations of one pose differ by a few percent (sampling),
+/// while a wrong frame of a random motion costs a multiple of it.
+const GIVEN_FRAME_SLACK: f64 = 0.05;
+/// Roots tried by the labelling at most: every shape of a small collection; beyond, evenly
+/// spread ones (each root costs a greedy pass and a few sweeps over the graph).
+const LABEL_ROOTS: usize = 32;
+/// Sweeps of iterated conditional modes at most: a label changes only when its summed cost
+/// drops, so it settles in a few sweeps.
+const ICM_SWEEPS: usize = 20;
 /// Sweeps of the synchronisation at most: each node's pose depends on its neighbours',
 /// settled in a few sweeps on graphs of diameter < 10.
 const SYNC_SWEEPS: usize = 10;
@@ -103,19 +128,27 @@ const SYNC_SWEEPS: usize = 10;
 /// Method (docs/ALIGN.md):
 /// 1. per shape, exact area moments and seeded area-weighted samples in its normalised frame
 ///    (centroid at 0, unit RMS radius);
-/// 2. a registration graph: each shape's [`AlignOptions::neighbours`] nearest shapes by a
+/// 2. each shape's **own symmetries**: the turns of its inertia frame (and the turns about a
+///    principal axis, for a surface of revolution) that overlay it on itself as closely as an
+///    independent resampling does — a stool's quarter turn, a goblet's stem;
+/// 3. a registration graph: each shape's [`AlignOptions::neighbours`] nearest shapes by a
 ///    rigid-invariant descriptor (the D2 histogram of sample distances and the inertia
 ///    spectrum), plus a minimum spanning tree of the descriptor distances so that the graph
-///    is connected; every edge registered by the pairwise method of
-///    [`register_pair`](super::register_pair), keeping each edge's distinct candidate poses;
-/// 3. **already aligned?** when at least half of the edges find their best pose at the given
-///    frames, the frames agree: every transform is the identity, bit for bit;
-/// 4. otherwise **synchronisation**: a spanning tree of the best edges from the shape with
-///    the lowest mean residual places every shape; then sweeps choose, for each shape, the
-///    pose that its neighbours' candidate poses (all of them, not only the best) support with
-///    the lowest total residual, and average the supporting poses (chordal mean) — so a
-///    symmetric shape follows its neighbours and one matching nothing well is placed by them;
-/// 5. the **up and forward axes** by a stated rule on the pooled, aligned samples: the up axis
+///    is connected; every edge registered by coarse trimmed ICP from the 24 starts
+///    `F_a P F_bᵀ` (the inertia frames turned by each cube rotation `P`) and from the given
+///    frames, each result kept under the start it ended nearest (a cost per relative label);
+/// 4. **already aligned?** an edge agrees with the given frames when its best pose is the
+///    given one up to the target's own symmetries, or ICP from the given frames stays there
+///    within [`GIVEN_FRAME_SLACK`] of the best residual; when at least half of the edges
+///    agree, every transform is the identity, bit for bit;
+/// 5. otherwise **joint labelling**: every shape `i` gets a cube rotation `P_i` (its candidate
+///    rotation into the collection frame is `P_i F_iᵀ`), chosen to minimise the summed
+///    label costs (log residual ratios) of all edges at once — greedy from a root, then
+///    iterated conditional modes, every shape tried as the root, the lowest total kept — so
+///    that an edge whose front/back alternative fits a little better is outvoted by the
+///    cycles through it; then each edge refined by trimmed ICP from its chosen pose on all
+///    samples, and the rotations averaged (chordal mean of what each shape's edges say);
+/// 6. the **up and forward axes** by a stated rule on the pooled, aligned samples: the up axis
 ///    is the principal axis (of the pooled covariance) along which the surface is most
 ///    lopsided (largest |third moment|), pointing away from the thin tail (chair legs, a
 ///    goblet's stem, an animal's legs: the light side is down); forward is the most lopsided
@@ -123,15 +156,17 @@ const SYNC_SWEEPS: usize = 10;
 ///    that up is `+y` and forward `+z`, centred on each shape's centroid and scaled by the
 ///    collection's geometric-mean RMS radius over the shape's.
 ///
-/// Cost: one registration per edge (about `n × neighbours` edges, ≈ 0.1 s each on one core
-/// for 1000 samples), independent of the mesh sizes beyond the moments.
+/// Cost: per edge (about `n × neighbours` edges) 25 coarse ICP runs and one refinement; per
+/// shape 25 self-comparisons; independent of the mesh sizes beyond the moments and samples.
 ///
 /// Deterministic: seeded samples, fixed orders, ties to the lower index.
 ///
 /// Errors: [`AlignError::Degenerate`] naming the shape index when a shape has no area;
 /// [`AlignError::BadOption`]; no shapes.
 ///
-/// Known issues: rigid: posed non-rigid shapes are placed by their overall shape only. The
+/// Known issues: rigid: posed non-rigid shapes are placed by their overall shape only. Shapes
+/// of one class that differ (a chair's back tilt) are placed by their best overlay on their
+/// neighbours, which can lie several degrees from the designer's frame. The
 /// up rule reads the geometry, not the files: on a collection whose files are upright it may
 /// still name another axis up (docs/ALIGN.md has the measured cases).
 pub fn align_collection(
@@ -161,39 +196,67 @@ pub fn align_collection(
                 residual: None,
                 ambiguity: None,
                 ambiguity_angle: None,
+                symmetries: Vec::new(),
             }],
             up: to_arr(&up),
             forward: to_arr(&forward),
             given_frame_share: 1.0,
             edges: Vec::new(),
+            symmetry_axis: own_symmetries(&prepared[0], &Cube::new())
+                .revolution
+                .map(|a| to_arr(&a)),
         });
     }
     let edges = registration_graph(&prepared, options.neighbours.max(1));
-    let regs: Vec<Vec<(Matrix3<f64>, f64)>> = edges
+    let cube = Cube::new();
+    let own: Vec<OwnSymmetries> = prepared
         .par_iter()
-        .map(|&(a, b)| {
-            let r = register_prepared(&prepared[a], &prepared[b], &options.register);
-            r.candidates
-                .iter()
-                .map(|c| (to_mat(&c.transform.rotation), c.residual))
-                .collect()
+        .map(|p| own_symmetries(p, &cube))
+        .collect();
+    let tables: Vec<EdgeTable> = edges
+        .par_iter()
+        .map(|&(a, b)| edge_table(&prepared[a], &prepared[b], &cube, &options.register))
+        .collect();
+    // The given frames agree on an edge when ICP from them stays there and fits about as well
+    // as the edge's best pose.
+    // The given frames agree on an edge when its best pose is the given one, up to the
+    // target's own symmetries (a stool turned a quarter, a goblet about its stem).
+    let given_agrees: Vec<bool> = edges
+        .iter()
+        .zip(&tables)
+        .map(|(&(_, b), t)| {
+            let k = (0..24)
+                .min_by(|&x, &y| t.cost[x].total_cmp(&t.cost[y]).then(x.cmp(&y)))
+                .unwrap_or(cube.identity);
+            let r = t.pose[k].rotation;
+            let near = |m: &Matrix3<f64>| angle(m, &Matrix3::identity()) < SAME_POSE_DEGREES;
+            let given_fits = angle(&t.given.rotation, &Matrix3::identity()) < SAME_POSE_DEGREES
+                && t.given.residual <= t.cost[k] * (1.0 + GIVEN_FRAME_SLACK);
+            given_fits
+                || near(&r)
+                || own[b].turns.iter().any(|s| near(&(r * s)))
+                || own[b]
+                    .revolution
+                    .is_some_and(|u| (r * u).dot(&u) >= SAME_POSE_DEGREES.to_radians().cos())
         })
         .collect();
-    let given = regs
-        .iter()
-        .filter(|c| angle(&c[0].0, &Matrix3::identity()) < SAME_POSE_DEGREES)
-        .count() as f64
-        / regs.len() as f64;
+    let given = given_agrees.iter().filter(|&&x| x).count() as f64 / tables.len() as f64;
     if given >= 0.5 {
         let rotations = vec![Matrix3::identity(); n];
+        let regs: Vec<Vec<(Matrix3<f64>, f64)>> = tables
+            .iter()
+            .map(|t| candidate_list(Some(&t.given), t))
+            .collect();
         let support = supports(n, &edges, &regs, &rotations);
         let (up, forward) = up_forward(&prepared, &rotations);
         return Ok(CollectionAlignment {
             case: FrameCase::AlreadyAligned,
             shapes: support
                 .into_iter()
-                .map(|s| ShapeAlignment {
+                .zip(&own)
+                .map(|(s, o)| ShapeAlignment {
                     transform: Similarity::identity(),
+                    symmetries: o.turns.iter().map(to_rows).collect(),
                     ..s
                 })
                 .collect(),
@@ -201,9 +264,37 @@ pub fn align_collection(
             forward: to_arr(&forward),
             given_frame_share: given,
             edges,
+            symmetry_axis: collection_revolution_axis(&own, &rotations).map(|a| to_arr(&a)),
         });
     }
-    let rotations = synchronise(n, &edges, &regs);
+    let w: Vec<[f64; 24]> = tables.iter().map(label_costs).collect();
+    let labels = label_shapes(n, &edges, &w, &cube);
+    let refined: Vec<Pose> = edges
+        .par_iter()
+        .zip(&tables)
+        .map(|(&(a, b), t)| {
+            let q = cube.rel[labels[a]][labels[b]];
+            icp(
+                &prepared[a],
+                &prepared[b],
+                options.register.samples,
+                t.pose[q],
+                options.register.max_iterations,
+                options.register.trim,
+            )
+        })
+        .collect();
+    let start: Vec<Matrix3<f64>> = labels
+        .iter()
+        .zip(&prepared)
+        .map(|(&l, p)| cube.perms[l] * p.moments.frame.transpose())
+        .collect();
+    let rotations = average_rotations(start, &edges, &refined);
+    let regs: Vec<Vec<(Matrix3<f64>, f64)>> = tables
+        .iter()
+        .zip(&refined)
+        .map(|(t, r)| candidate_list(Some(r), t))
+        .collect();
     let support = supports(n, &edges, &regs, &rotations);
     let (up, forward) = up_forward(&prepared, &rotations);
     // Rows of the frame are its axes (right, up, forward) in the synchronised frame.
@@ -215,8 +306,14 @@ pub fn align_collection(
         .into_iter()
         .zip(&prepared)
         .zip(&rotations)
-        .map(|((s, p), g)| {
+        .zip(&own)
+        .map(|(((s, p), g), o)| {
             let r = frame * g;
+            let symmetries = o
+                .turns
+                .iter()
+                .map(|t| to_rows(&(r * t * r.transpose())))
+                .collect();
             let scale = mean_radius / p.moments.radius;
             let t = -(r * p.moments.centroid) * scale;
             ShapeAlignment {
@@ -225,6 +322,7 @@ pub fn align_collection(
                     scale,
                     translation: to_arr(&t),
                 },
+                symmetries,
                 ..s
             }
         })
@@ -236,6 +334,7 @@ pub fn align_collection(
         forward: [0.0, 0.0, 1.0],
         given_frame_share: given,
         edges,
+        symmetry_axis: collection_revolution_axis(&own, &rotations).map(|a| to_arr(&(frame * a))),
     })
 }
 
@@ -269,89 +368,6 @@ fn edge_cost(h: &Matrix3<f64>, hyps: &[(Matrix3<f64>, f64)]) -> (f64, Option<usi
         .filter(|(_, x)| angle(&x.0, h) < SAME_POSE_DEGREES)
         .min_by(|a, b| a.1.1.total_cmp(&b.1.1))
         .map_or((worst, None), |(k, x)| (x.1, Some(k)))
-}
-
-fn synchronise(
-    n: usize,
-    edges: &[(usize, usize)],
-    regs: &[Vec<(Matrix3<f64>, f64)>],
-) -> Vec<Matrix3<f64>> {
-    let incident: Vec<Vec<usize>> = (0..n)
-        .map(|v| {
-            (0..edges.len())
-                .filter(|&e| edges[e].0 == v || edges[e].1 == v)
-                .collect()
-        })
-        .collect();
-    // Root: the lowest mean best residual over its edges.
-    let mean_best = |v: usize| {
-        incident[v].iter().map(|&e| regs[e][0].1).sum::<f64>() / incident[v].len().max(1) as f64
-    };
-    let root = (0..n)
-        .min_by(|&a, &b| mean_best(a).total_cmp(&mean_best(b)))
-        .unwrap_or(0);
-    // Prim's tree over the best residuals.
-    let mut g: Vec<Option<Matrix3<f64>>> = vec![None; n];
-    g[root] = Some(Matrix3::identity());
-    loop {
-        let next = (0..edges.len())
-            .filter(|&e| g[edges[e].0].is_some() != g[edges[e].1].is_some())
-            .min_by(|&a, &b| regs[a][0].1.total_cmp(&regs[b][0].1));
-        let Some(e) = next else { break };
-        let (a, b) = edges[e];
-        let (node, other) = if g[a].is_some() { (b, a) } else { (a, b) };
-        let h = hypotheses(node, edges[e], &regs[e][..1], &g[other].unwrap());
-        g[node] = Some(h[0].0);
-    }
-    let mut g: Vec<Matrix3<f64>> = g
-        .into_iter()
-        .map(|x| x.unwrap_or_else(Matrix3::identity))
-        .collect();
-    for _ in 0..SYNC_SWEEPS {
-        let mut changed = false;
-        for v in 0..n {
-            let per_edge: Vec<Vec<(Matrix3<f64>, f64)>> = incident[v]
-                .iter()
-                .map(|&e| {
-                    let other = if edges[e].0 == v {
-                        edges[e].1
-                    } else {
-                        edges[e].0
-                    };
-                    hypotheses(v, edges[e], &regs[e], &g[other])
-                })
-                .collect();
-            let all: Vec<Matrix3<f64>> = per_edge.iter().flatten().map(|x| x.0).collect();
-            let score =
-                |h: &Matrix3<f64>| per_edge.iter().map(|hy| edge_cost(h, hy).0).sum::<f64>();
-            let mut best = g[v];
-            let mut best_score = score(&g[v]);
-            for h in &all {
-                let s = score(h);
-                if s < best_score - 1e-12 {
-                    best = *h;
-                    best_score = s;
-                }
-            }
-            let agreeing: Vec<Matrix3<f64>> = per_edge
-                .iter()
-                .filter_map(|hy| edge_cost(&best, hy).1.map(|k| hy[k].0))
-                .collect();
-            let new = if agreeing.is_empty() {
-                best
-            } else {
-                chordal_mean(&agreeing)
-            };
-            if angle(&new, &g[v]) > 1e-6 {
-                changed = true;
-            }
-            g[v] = new;
-        }
-        if !changed {
-            break;
-        }
-    }
-    g
 }
 
 /// Per shape: confidence, residual and ambiguity of the placement `g`.
@@ -399,6 +415,7 @@ fn supports(
                     .then(|| agree.iter().sum::<f64>() / agree.len() as f64),
                 ambiguity: other.map(|(s, _)| if s > 0.0 { (score / s).min(1.0) } else { 1.0 }),
                 ambiguity_angle: other.map(|(_, a)| a),
+                symmetries: Vec::new(),
             }
         })
         .collect()
@@ -524,10 +541,345 @@ fn to_rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     ]
 }
 
-fn to_mat(r: &[[f64; 3]; 3]) -> Matrix3<f64> {
-    Matrix3::from_fn(|i, j| r[i][j])
-}
-
 fn to_arr(v: &Vector3<f64>) -> [f64; 3] {
     [v.x, v.y, v.z]
+}
+/// One edge's registrations: for each of the 24 relative inertia-frame labels, the best
+/// coarse pose that ICP reached nearest that label's start, and the pose reached from the
+/// given frames.
+struct EdgeTable {
+    /// Coarse symmetric trimmed chamfer per relative label (`INFINITY` when no start ended
+    /// nearest that label: it is no local minimum).
+    cost: [f64; 24],
+    /// The pose per relative label (its start when no start ended there).
+    pose: [Pose; 24],
+    /// ICP from the given frames (the identity start).
+    given: Pose,
+}
+
+/// The 24 rotations of the cube and their composition table `rel[a][b]` = index of
+/// `P_aᵀ P_b`.
+struct Cube {
+    perms: Vec<Matrix3<f64>>,
+    rel: Vec<[usize; 24]>,
+    identity: usize,
+}
+
+impl Cube {
+    fn new() -> Self {
+        let perms = signed_permutations();
+        let find = |m: &Matrix3<f64>| {
+            perms
+                .iter()
+                .position(|p| (p - m).abs().max() < 1e-9)
+                .expect("the cube rotations form a group")
+        };
+        let rel = (0..24)
+            .map(|a| std::array::from_fn(|b| find(&(perms[a].transpose() * perms[b]))))
+            .collect();
+        let identity = find(&Matrix3::identity());
+        Self {
+            perms,
+            rel,
+            identity,
+        }
+    }
+}
+
+/// Registers target `b` onto source `a` from every relative label's start and from the given
+/// frames (coarse ICP), attributing each result to the label whose start it ended nearest.
+fn edge_table(s: &Prepared, t: &Prepared, cube: &Cube, options: &RegisterOptions) -> EdgeTable {
+    let starts: Vec<Matrix3<f64>> = cube
+        .perms
+        .iter()
+        .map(|p| s.moments.frame * p * t.moments.frame.transpose())
+        .chain(std::iter::once(Matrix3::identity()))
+        .collect();
+    let coarse_n = COARSE_SAMPLES.min(options.samples);
+    let results: Vec<Pose> = starts
+        .iter()
+        .map(|r| {
+            icp(
+                s,
+                t,
+                coarse_n,
+                Pose {
+                    rotation: *r,
+                    translation: Vector3::zeros(),
+                    residual: f64::INFINITY,
+                },
+                COARSE_ITERATIONS,
+                options.trim,
+            )
+        })
+        .collect();
+    let mut cost = [f64::INFINITY; 24];
+    let mut pose: [Pose; 24] = std::array::from_fn(|k| Pose {
+        rotation: starts[k],
+        translation: Vector3::zeros(),
+        residual: f64::INFINITY,
+    });
+    for r in &results[..24] {
+        let k = (0..24)
+            .min_by(|&x, &y| {
+                angle(&starts[x], &r.rotation).total_cmp(&angle(&starts[y], &r.rotation))
+            })
+            .unwrap_or(0);
+        if r.residual < cost[k] {
+            cost[k] = r.residual;
+            pose[k] = *r;
+        }
+    }
+    EdgeTable {
+        cost,
+        pose,
+        given: results[24],
+    }
+}
+
+/// Per edge, the labelling cost of each relative label: `ln(cost / best cost)` (0 for the
+/// edge's best pose), labels that are no local minimum at the edge's worst. A log ratio, so
+/// that a pair of dissimilar shapes (large residuals everywhere) weighs no more than a pair of
+/// similar ones.
+fn label_costs(table: &EdgeTable) -> [f64; 24] {
+    let finite = table.cost.iter().copied().filter(|c| c.is_finite());
+    let best = finite.clone().fold(f64::INFINITY, f64::min).max(1e-12);
+    let worst = finite.fold(best, f64::max);
+    table
+        .cost
+        .map(|c| (if c.is_finite() { c } else { worst } / best).ln())
+}
+
+/// A label per shape (an index into the cube rotations: shape `i` goes to the collection
+/// frame by `P_{lᵢ} F_iᵀ`) minimising the summed label costs over the edges: greedy from a
+/// root, then iterated conditional modes; every shape (at most [`LABEL_ROOTS`]) tried as the
+/// root, the lowest total kept (ties to the lower root).
+fn label_shapes(n: usize, edges: &[(usize, usize)], w: &[[f64; 24]], cube: &Cube) -> Vec<usize> {
+    let incident: Vec<Vec<usize>> = (0..n)
+        .map(|v| {
+            (0..edges.len())
+                .filter(|&e| edges[e].0 == v || edges[e].1 == v)
+                .collect()
+        })
+        .collect();
+    let local = |v: usize, l: usize, labels: &[Option<usize>]| -> f64 {
+        incident[v]
+            .iter()
+            .filter_map(|&e| {
+                let (a, b) = edges[e];
+                if a == v {
+                    labels[b].map(|lb| w[e][cube.rel[l][lb]])
+                } else {
+                    labels[a].map(|la| w[e][cube.rel[la][l]])
+                }
+            })
+            .sum()
+    };
+    let step = n.div_ceil(LABEL_ROOTS).max(1);
+    let mut best: Option<(f64, Vec<usize>)> = None;
+    for root in (0..n).step_by(step) {
+        let mut labels: Vec<Option<usize>> = vec![None; n];
+        labels[root] = Some(cube.identity);
+        for _ in 1..n {
+            // The next shape: the one with the most placed neighbours.
+            let placed = |v: usize| {
+                incident[v]
+                    .iter()
+                    .filter(|&&e| {
+                        let o = if edges[e].0 == v {
+                            edges[e].1
+                        } else {
+                            edges[e].0
+                        };
+                        labels[o].is_some()
+                    })
+                    .count()
+            };
+            let Some(v) = (0..n)
+                .filter(|&v| labels[v].is_none())
+                .max_by(|&x, &y| placed(x).cmp(&placed(y)).then(y.cmp(&x)))
+            else {
+                break;
+            };
+            let l = (0..24)
+                .min_by(|&x, &y| local(v, x, &labels).total_cmp(&local(v, y, &labels)))
+                .unwrap_or(cube.identity);
+            labels[v] = Some(l);
+        }
+        for _ in 0..ICM_SWEEPS {
+            let mut changed = false;
+            for v in 0..n {
+                let current = labels[v].unwrap_or(cube.identity);
+                let mut pick = (local(v, current, &labels), current);
+                for l in 0..24 {
+                    let c = local(v, l, &labels);
+                    if c < pick.0 - 1e-12 {
+                        pick = (c, l);
+                    }
+                }
+                if pick.1 != current {
+                    labels[v] = Some(pick.1);
+                    changed = true;
+                }
+            }
+            if !changed {
+                break;
+            }
+        }
+        let labels: Vec<usize> = labels
+            .into_iter()
+            .map(|l| l.unwrap_or(cube.identity))
+            .collect();
+        let energy: f64 = edges
+            .iter()
+            .enumerate()
+            .map(|(e, &(a, b))| w[e][cube.rel[labels[a]][labels[b]]])
+            .sum();
+        if best.as_ref().is_none_or(|(b, _)| energy < b - 1e-12) {
+            best = Some((energy, labels));
+        }
+    }
+    best.map(|b| b.1).unwrap_or_else(|| vec![cube.identity; n])
+}
+
+/// Rotation averaging: each shape's rotation set to the chordal mean of what its refined
+/// edges say it is (those within [`SAME_POSE_DEGREES`] of its current rotation), a few
+/// sweeps from the labelling's rotations.
+fn average_rotations(
+    mut g: Vec<Matrix3<f64>>,
+    edges: &[(usize, usize)],
+    refined: &[Pose],
+) -> Vec<Matrix3<f64>> {
+    let n = g.len();
+    for _ in 0..SYNC_SWEEPS {
+        let mut moved = 0.0f64;
+        for v in 0..n {
+            let says: Vec<Matrix3<f64>> = edges
+                .iter()
+                .zip(refined)
+                .filter_map(|(&(a, b), p)| {
+                    if b == v {
+                        Some(g[a] * p.rotation)
+                    } else if a == v {
+                        Some(g[b] * p.rotation.transpose())
+                    } else {
+                        None
+                    }
+                })
+                .filter(|h| angle(h, &g[v]) < SAME_POSE_DEGREES)
+                .collect();
+            if !says.is_empty() {
+                let new = chordal_mean(&says);
+                moved = moved.max(angle(&new, &g[v]));
+                g[v] = new;
+            }
+        }
+        if moved < 1e-3 {
+            break;
+        }
+    }
+    g
+}
+
+/// An edge's distinct poses, best first: `first` (the refined or the given pose), then the
+/// coarse label poses more than [`SAME_POSE_DEGREES`] from it and from each other.
+fn candidate_list(first: Option<&Pose>, t: &EdgeTable) -> Vec<(Matrix3<f64>, f64)> {
+    let mut order: Vec<usize> = (0..24).filter(|&k| t.cost[k].is_finite()).collect();
+    order.sort_by(|&x, &y| t.cost[x].total_cmp(&t.cost[y]).then(x.cmp(&y)));
+    let mut out: Vec<(Matrix3<f64>, f64)> = first
+        .map(|p| (p.rotation, p.residual))
+        .into_iter()
+        .collect();
+    for k in order {
+        if out
+            .iter()
+            .all(|(r, _)| angle(r, &t.pose[k].rotation) >= SAME_POSE_DEGREES)
+        {
+            out.push((t.pose[k].rotation, t.cost[k]));
+        }
+    }
+    out
+}
+
+/// Angles (degrees) at which a shape is compared with itself turned about an axis: none of
+/// them a symmetry of a box, an n-gon prism of small n or a chair, all of them of a surface of
+/// revolution.
+const SYMMETRY_TEST_DEGREES: [f64; 3] = [37.0, 101.0, 163.0];
+/// A turned shape overlays itself "as well as an independent resampling does" within this
+/// factor of the resampling's chamfer: a surface of revolution faceted in 16 or more sectors
+/// stays within it, a shape with any distinct side (a handle, a chair back) doubles it.
+const SYMMETRY_SLACK: f64 = 1.5;
+
+/// A shape's own symmetries, in its normalised frame: the proper rotations among
+/// `F P Fᵀ` (its inertia frame `F` turned by a non-identity cube rotation `P`: a symmetry of a
+/// shape always maps its inertia frame onto itself) that overlay the shape on itself, and the
+/// axis about which it is a surface of revolution, if any.
+///
+/// Test: the first half of the samples against the second half turned (symmetric chamfer);
+/// a turn is a symmetry when it stays within [`SYMMETRY_SLACK`] times the chamfer of the
+/// unturned halves (the resampling floor); an axis is one of revolution when every turn of
+/// [`SYMMETRY_TEST_DEGREES`] about it is a symmetry.
+pub(crate) struct OwnSymmetries {
+    turns: Vec<Matrix3<f64>>,
+    revolution: Option<Vector3<f64>>,
+}
+
+fn own_symmetries(p: &Prepared, cube: &Cube) -> OwnSymmetries {
+    let half = p.samples.len() / 2;
+    if half < 10 {
+        return OwnSymmetries {
+            turns: Vec::new(),
+            revolution: None,
+        };
+    }
+    let (a, b) = p.samples.split_at(half);
+    let ia = PointIndex::new(a);
+    let ib = PointIndex::new(b);
+    let chamfer = |r: &Matrix3<f64>| {
+        let rt = r.transpose();
+        let f = b.iter().map(|y| ia.nearest(&(r * y)).1).sum::<f64>() / b.len() as f64;
+        let g = a.iter().map(|x| ib.nearest(&(rt * x)).1).sum::<f64>() / a.len() as f64;
+        0.5 * (f + g)
+    };
+    let limit = SYMMETRY_SLACK * chamfer(&Matrix3::identity());
+    let frame = p.moments.frame;
+    let turns = (0..24)
+        .filter(|&k| k != cube.identity)
+        .map(|k| frame * cube.perms[k] * frame.transpose())
+        .filter(|r| chamfer(r) <= limit)
+        .collect();
+    let revolution = (0..3).map(|k| Vector3::from(frame.column(k))).find(|axis| {
+        SYMMETRY_TEST_DEGREES.iter().all(|deg| {
+            let r = nalgebra::Rotation3::from_axis_angle(
+                &nalgebra::Unit::new_normalize(*axis),
+                deg.to_radians(),
+            );
+            chamfer(r.matrix()) <= limit
+        })
+    });
+    OwnSymmetries { turns, revolution }
+}
+
+/// The collection's axis of revolution in the collection frame (rows of `g` take each shape
+/// into it): when at least half of the shapes are surfaces of revolution and their axes agree
+/// within [`SAME_POSE_DEGREES`] (up to sign) — rotations about it are then undetermined and
+/// not an error of the alignment.
+fn collection_revolution_axis(own: &[OwnSymmetries], g: &[Matrix3<f64>]) -> Option<Vector3<f64>> {
+    let axes: Vec<Vector3<f64>> = own
+        .iter()
+        .zip(g)
+        .filter_map(|(o, r)| o.revolution.map(|a| r * a))
+        .collect();
+    if axes.is_empty() || 2 * axes.len() < own.len() {
+        return None;
+    }
+    let mut sum = Vector3::zeros();
+    for a in &axes {
+        sum += if a.dot(&axes[0]) < 0.0 { -a } else { *a };
+    }
+    let mean = sum.normalize();
+    let limit = SAME_POSE_DEGREES.to_radians().cos();
+    axes.iter()
+        .all(|a| a.dot(&mean).abs() >= limit)
+        .then_some(mean)
 }

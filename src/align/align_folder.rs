@@ -41,6 +41,7 @@ struct TransformsFile<'a> {
     given_frame_share: f64,
     shapes: Vec<ShapeEntry<'a>>,
     edges: &'a [(usize, usize)],
+    symmetry_axis: Option<[f64; 3]>,
 }
 
 #[derive(Serialize)]
@@ -110,6 +111,7 @@ pub fn align_folder(
         up: alignment.up,
         forward: alignment.forward,
         given_frame_share: alignment.given_frame_share,
+        symmetry_axis: alignment.symmetry_axis,
         shapes: files
             .iter()
             .zip(&alignment.shapes)

@@ -92,7 +92,7 @@ pub struct Registration {
 const REFINED: usize = 4;
 /// Iterations of the coarse pass: ICP from a principal-frame start settles in a few steps;
 /// the coarse pass only ranks the starts.
-const COARSE_ITERATIONS: usize = 6;
+pub(crate) const COARSE_ITERATIONS: usize = 6;
 /// Two rotations are "the same pose" within this angle (degrees): ICP runs from different
 /// starts that reach one minimum end within a degree or two of each other; distinct
 /// symmetric poses of real shapes are 90° or 180° apart.
