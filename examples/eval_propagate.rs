@@ -34,6 +34,11 @@
 //! (`coseg::align::nearest_point_vertex_labels`, from the per-vertex annotation); from several
 //! sources, each target from its best-registered source (lowest residual).
 //! `labelled` scores grouped parts (the manifest's `part_groups`, as `coseg::evaluate` does).
+//! With the environment variable `COSEG_DIAG` set, every run prints on stderr, per target,
+//! each route's accuracy and its weight in the fusion, the fused accuracy and the area shares
+//! of the routes' agreement patterns (all three agree, only affinity and parts, only affinity
+//! and rigid, only parts and rigid, none), and with several sources each route's held-out
+//! accuracy on the sources.
 //! Accuracy is area-weighted: per face against `.seg` files for the chairs, per vertex for
 //! the identity sets; the source shapes are left out of every mean.
 
@@ -156,12 +161,64 @@ fn run(
         &ann,
         &mut p,
         Some(&mut *set.parts.lock().unwrap()),
+        set.smoothers.as_deref(),
+        options,
         &set.routes,
     )?;
     for w in &report.warnings {
         eprintln!("warning: {w}");
     }
     let targets: Vec<usize> = (0..n).filter(|i| !sources.contains(i)).collect();
+    if std::env::var_os("COSEG_DIAG").is_some() {
+        if let Some(h) = &report.held_out {
+            eprintln!("diag held-out {:?}", h);
+        }
+        // Per target: each route's accuracy and weight, the fusion's accuracy, and the
+        // area shares of the agreement patterns of the first three routes.
+        for &i in &targets {
+            let mut line = format!("diag {:>12}", set.names[i]);
+            for (x, (route, labels)) in report.routes.iter().enumerate() {
+                if labels.votes_on(i) {
+                    line += &format!(
+                        " {}={:.1}/w{:.2}",
+                        route.name(),
+                        100.0 * score(i, &labels.labels[i]),
+                        report.fused.weights[i][x]
+                    );
+                }
+            }
+            line += &format!(" fused={:.1}", 100.0 * score(i, &report.fused.labels[i]));
+            if report.routes.len() == 3 && (0..3).all(|x| report.routes[x].1.votes_on(i)) {
+                let a = &set.graph.node(i).areas;
+                let tot: f64 = a.iter().sum();
+                let mut f = [0.0; 5];
+                for (v, &av) in a.iter().enumerate() {
+                    let (x, y, z) = (
+                        report.routes[0].1.labels[i][v],
+                        report.routes[1].1.labels[i][v],
+                        report.routes[2].1.labels[i][v],
+                    );
+                    let k = if x == y && y == z {
+                        0
+                    } else if x == y {
+                        1
+                    } else if x == z {
+                        2
+                    } else if y == z {
+                        3
+                    } else {
+                        4
+                    };
+                    f[k] += av / tot;
+                }
+                line += &format!(
+                    " all={:.2} AP={:.2} AR={:.2} PR={:.2} none={:.2}",
+                    f[0], f[1], f[2], f[3], f[4]
+                );
+            }
+            eprintln!("{line}");
+        }
+    }
     let mut log = set.route_log.lock().unwrap();
     for (route, labels) in &report.routes {
         let r: Vec<(usize, f64)> = targets

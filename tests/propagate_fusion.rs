@@ -4,7 +4,7 @@
 mod common;
 
 use coseg::graph::{Cosegmentation, RegionTuple};
-use coseg::propagate::{RouteLabels, fuse_routes, parts_route};
+use coseg::propagate::{RouteLabels, fuse_routes, fuse_routes_with, parts_route};
 use rand::{RngExt, SeedableRng};
 
 /// Route labels on shape 1 of two (shape 0 a source): `labels` with confidence `conf`.
@@ -256,4 +256,98 @@ fn refine_affine_overlays_a_stretched_copy_that_a_similarity_cannot() {
             assert!(after < 0.5 * before, "{what}: {before} -> {after}");
         }
     }
+}
+
+/// Truth in six labels over `d` vertices; a rigid-like route right except on a seeded 8 %;
+/// two intrinsic-like routes that both give the mirror label (`l ^ 1`) on the same 25 % of
+/// the vertices (the mirror parts they cannot tell apart) and elsewhere are wrong
+/// independently on a seeded 20 % each.
+fn mirror_confused(d: usize) -> (Vec<i32>, [RouteLabels; 3]) {
+    let truth: Vec<i32> = (0..d).map(|v| (6 * v / d) as i32).collect();
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
+    let noisy = |l: i32, p: f64, rng: &mut rand_chacha::ChaCha8Rng| {
+        if rng.random::<f64>() < p {
+            (l + rng.random_range(1..6)) % 6
+        } else {
+            l
+        }
+    };
+    let (mut a, mut b, mut r) = (Vec::new(), Vec::new(), Vec::new());
+    for &l in &truth {
+        if rng.random::<f64>() < 0.25 {
+            a.push(l ^ 1);
+            b.push(l ^ 1);
+        } else {
+            a.push(noisy(l, 0.2, &mut rng));
+            b.push(noisy(l, 0.2, &mut rng));
+        }
+        r.push(noisy(l, 0.08, &mut rng));
+    }
+    (truth, [route(a, 0.5), route(b, 0.5), route(r, 0.5)])
+}
+
+#[test]
+fn intrinsic_routes_failing_together_do_not_outvote_the_rigid_route() {
+    // Regression: from one FAUST body the band affinity and the parts route both confused
+    // left and right limbs; their joint failure read as agreement under the one-coin model,
+    // so the fusion (74.7 %) stayed far under the rigid route (92.1 %).
+    let d = 6000;
+    let (truth, routes) = mirror_confused(d);
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas = [vec![1.0; 4], vec![1.0; d]];
+    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
+    let one_coin = accuracy(&fuse_routes(&refs, &area_refs).labels[1], &truth);
+    let fused = fuse_routes_with(&refs, &area_refs, None, Some((0, 1)));
+    let shared = accuracy(&fused.labels[1], &truth);
+    let rigid = accuracy(&routes[2].labels[1], &truth);
+    assert!(
+        shared > rigid - 0.01,
+        "shared-failure vote {shared}, rigid {rigid}"
+    );
+    assert!(
+        shared > one_coin + 0.05,
+        "shared {shared}, one-coin {one_coin}"
+    );
+    let w = &fused.weights[1];
+    assert!(w[2] > w[0] && w[2] > w[1], "weights {w:?}");
+    // Deterministic.
+    assert_eq!(
+        fused,
+        fuse_routes_with(&refs, &area_refs, None, Some((0, 1)))
+    );
+}
+
+#[test]
+fn a_pair_that_fails_independently_is_fused_as_before() {
+    // The shared-failure model finds no shared share when the pair fails independently: the
+    // route the others agree with still wins where it is outvoted.
+    let d = 3000;
+    let (truth, b) = truth_and_noisy(d, 0.4, 1);
+    let (_, c) = truth_and_noisy(d, 0.4, 2);
+    let routes = [route(b, 0.5), route(c, 0.5), route(truth.clone(), 0.5)];
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas = [vec![1.0; 10], vec![1.0; d]];
+    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
+    let fused = fuse_routes_with(&refs, &area_refs, None, Some((0, 1)));
+    let acc = accuracy(&fused.labels[1], &truth);
+    assert!(acc > 0.99, "fused accuracy {acc}");
+}
+
+#[test]
+fn held_out_accuracies_set_the_level_of_each_routes_trust() {
+    // The same mirror-confused routes, fused without the pair but with each route's accuracy
+    // as measured on the sources: the rigid route, the most accurate there, gets the largest
+    // weight (the vote still adds the pair's weights where they agree: the held-out level
+    // corrects the trust, not the pair's joint failures).
+    let d = 6000;
+    let (truth, routes) = mirror_confused(d);
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas = [vec![1.0; 4], vec![1.0; d]];
+    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
+    let one_coin = accuracy(&fuse_routes(&refs, &area_refs).labels[1], &truth);
+    let fused = fuse_routes_with(&refs, &area_refs, Some(&[0.65, 0.65, 0.92]), None);
+    let acc = accuracy(&fused.labels[1], &truth);
+    assert!(acc >= one_coin, "held-out {acc}, one-coin {one_coin}");
+    let w = &fused.weights[1];
+    assert!(w[2] > w[0] && w[2] > w[1], "weights {w:?}");
 }

@@ -399,6 +399,8 @@ pub fn propagate_loaded(
         annotations,
         &mut propagation,
         parts.as_mut(),
+        smooth,
+        &options.propagate,
         &options.routes,
     )?;
     warnings.extend(fusion.warnings.iter().cloned());

@@ -1,13 +1,14 @@
 //! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
 
 use super::{
-    FusedRoutes, PropagateError, Propagation, Route, RouteLabels, fuse_routes, parts_route,
-    rigid_route, snap_labels,
+    FusedRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
+    fuse_routes_with, held_out_accuracy, parts_route, rigid_route, snap_labels,
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
 use crate::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions, segment_collection};
 use crate::pipeline::ShapePipelineOptions;
+use crate::spectral::HeatSmoother;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::PathBuf;
@@ -142,6 +143,9 @@ pub struct FusionReport {
     pub fused: FusedRoutes,
     /// Optional routes that could not run, for the user.
     pub warnings: Vec<String>,
+    /// Per route (the order of `routes`), its accuracy on the sources, each carried to from
+    /// the others ([`held_out_accuracy`]); `None` with fewer than two sources.
+    pub held_out: Option<Vec<f64>>,
 }
 
 /// Fuses the band-affinity `propagation` with the other correspondence routes of `options`
@@ -150,19 +154,27 @@ pub struct FusionReport {
 /// shapes' labels and confidences in `propagation` (the sources keep their annotations), so that
 /// [`Propagation::update`] continues from them.
 ///
+/// With two sources or more each route's trust is set by its accuracy on the sources
+/// themselves ([`held_out_accuracy`], [`fuse_routes_held_out`]): every source carried to from
+/// the others by each route and scored against its own labels.
+///
 /// Inputs: `graph`, `meshes` (#shapes, graph order), `annotations` (as given to
 /// [`super::propagate_labels`]), the affinity `propagation` of them, `parts` (the
-/// collection's co-segmentations, reused across calls; `None` skips the parts route).
+/// collection's co-segmentations, reused across calls; `None` skips the parts route),
+/// `smoothers` and `propagate` as the affinity solve used them (the held-out runs repeat it).
 /// Output: the [`FusionReport`]. An optional route that fails (its co-segmentation cannot be
 /// made) is left out with a warning.
 ///
 /// Errors: [`PropagateError::BadOption`] for invalid options or inputs that do not fit.
+#[allow(clippy::too_many_arguments)]
 pub fn fuse_propagation(
     graph: &ShapeGraph,
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
     propagation: &mut Propagation,
     parts: Option<&mut CollectionParts>,
+    smoothers: Option<&[HeatSmoother]>,
+    propagate: &PropagateOptions,
     options: &RouteOptions,
 ) -> Result<FusionReport, PropagateError> {
     options.validate()?;
@@ -183,12 +195,16 @@ pub fn fuse_propagation(
         affinity.shape_confidence[i] = propagation.shape_confidence[i];
     }
     report.routes.push((Route::Affinity, affinity));
+    let mut segmentation = None;
     if let (true, Some(parts)) = (options.parts, parts) {
         let count = propagation.parts.len();
         match parts.parts(count, meshes) {
-            Ok(seg) => report
-                .routes
-                .push((Route::Parts, parts_route(seg, annotations, &areas))),
+            Ok(seg) => {
+                report
+                    .routes
+                    .push((Route::Parts, parts_route(seg, annotations, &areas)));
+                segmentation = Some(seg);
+            }
             Err(e) => report
                 .warnings
                 .push(format!("parts route off: the co-segmentation failed: {e}")),
@@ -199,8 +215,24 @@ pub fn fuse_propagation(
         report.warnings.extend(warnings);
         report.routes.push((Route::Rigid, rigid));
     }
+    let names: Vec<Route> = report.routes.iter().map(|(r, _)| *r).collect();
+    report.held_out = held_out_accuracy(
+        graph,
+        meshes,
+        annotations,
+        smoothers,
+        propagate,
+        &names,
+        segmentation,
+        options.affine,
+    )?;
     let refs: Vec<&RouteLabels> = report.routes.iter().map(|(_, r)| r).collect();
-    report.fused = fuse_routes(&refs, &areas);
+    // The two routes that read the intrinsic band features may fail together.
+    let shared = names
+        .iter()
+        .position(|&r| r == Route::Affinity)
+        .zip(names.iter().position(|&r| r == Route::Parts));
+    report.fused = fuse_routes_with(&refs, &areas, report.held_out.as_deref(), shared);
     let snapped = snap_labels(meshes, &report.fused.labels, options.snap_band)?;
     for (i, labels) in snapped.into_iter().enumerate() {
         if annotations[i].is_some() || labels.is_empty() {

@@ -23,6 +23,7 @@
 mod collection;
 mod fuse_propagation;
 mod fuse_routes;
+mod held_out;
 mod map_step;
 mod options;
 mod part_scores;
@@ -37,7 +38,8 @@ pub use collection::{
     map_step_collection, propagate_collection, propagate_loaded,
 };
 pub use fuse_propagation::{CollectionParts, FusionReport, RouteOptions, fuse_propagation};
-pub use fuse_routes::{FusedRoutes, Route, RouteLabels, fuse_routes};
+pub use fuse_routes::{FusedRoutes, Route, RouteLabels, fuse_routes, fuse_routes_with};
+pub use held_out::held_out_accuracy;
 pub use map_step::{MapStepOptions, MapStepReport, map_step};
 pub use options::PropagateOptions;
 pub use part_scores::PartScore;

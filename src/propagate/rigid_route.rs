@@ -36,6 +36,20 @@ pub fn rigid_route(
     annotations: &[Option<Vec<i32>>],
     affine: bool,
 ) -> (RouteLabels, Vec<String>) {
+    let targets: Vec<usize> = (0..meshes.len())
+        .filter(|&i| annotations[i].is_none())
+        .collect();
+    rigid_route_to(meshes, annotations, affine, &targets)
+}
+
+/// [`rigid_route`] on the unlabelled shapes `targets` only (the others get no vote): the
+/// held-out check ([`super::held_out`]) carries the labels to one source at a time.
+pub(crate) fn rigid_route_to(
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    affine: bool,
+    targets: &[usize],
+) -> (RouteLabels, Vec<String>) {
     let n = meshes.len();
     let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
     let options = RegisterOptions::default();
@@ -43,7 +57,7 @@ pub fn rigid_route(
     let results: Vec<Option<Carried>> = (0..n)
         .into_par_iter()
         .map(|i| {
-            if annotations[i].is_some() {
+            if annotations[i].is_some() || !targets.contains(&i) {
                 return None;
             }
             let mut best: Option<(f64, usize, crate::align::Registration)> = None;

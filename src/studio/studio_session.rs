@@ -655,6 +655,8 @@ impl Studio {
             &self.annotations,
             &mut s.propagation,
             s.parts.as_mut(),
+            (!s.smoothers.is_empty()).then_some(s.smoothers.as_slice()),
+            &self.options.propagate,
             &self.options.routes,
         )?;
         Ok(fusion.warnings)
