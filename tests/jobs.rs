@@ -164,3 +164,131 @@ fn eval_job_writes_its_scores_and_names_what_it_cannot_score() {
     assert!(err.to_string().contains("missing"), "{err}");
     assert!(!dir.path().join("none.json").exists());
 }
+
+mod propagate_job {
+    use super::*;
+    use coseg::jobs::{JobLabels, PropagateInput, PropagateJob, run_propagate};
+
+    fn job(output: Option<PathBuf>) -> PropagateJob {
+        let mut job = PropagateJob::default();
+        job.propagation.pipeline = small_pipeline(24, 4);
+        job.output = output;
+        job
+    }
+
+    /// Three blobs in a folder; the first labelled by height (two parts) in `<stem>.labels.txt`.
+    fn folder(dir: &Path) -> (PathBuf, Vec<i64>) {
+        let shapes = dir.join("shapes");
+        std::fs::create_dir_all(&shapes).unwrap();
+        for (i, s) in [1.0, 1.2, 0.9].into_iter().enumerate() {
+            coseg::mesh::write_mesh(
+                shapes.join(format!("s{i}.off")),
+                &similarity(&blob(2), s),
+                &[],
+            )
+            .unwrap();
+        }
+        let m = coseg::mesh::read_mesh(shapes.join("s0.off")).unwrap();
+        // Above and below the mean height: two parts whatever the blob's placement.
+        let p = m.positions();
+        let mid = p.iter().map(|v| v[1]).sum::<f64>() / p.len() as f64;
+        let labels: Vec<i64> = p.iter().map(|v| i64::from(v[1] > mid)).collect();
+        let text: String = labels.iter().map(|l| format!("{l}\n")).collect();
+        std::fs::write(dir.join("s0.labels.txt"), text).unwrap();
+        (shapes, labels)
+    }
+
+    /// A folder with label files and the same shapes in memory with the same labels as an
+    /// array give the same labels: `coseg propagate` and `coseg.propagate` run one job.
+    #[test]
+    fn a_folder_and_shapes_in_memory_give_the_same_labels() {
+        let dir = tempfile::tempdir().unwrap();
+        let (shapes, labels) = folder(dir.path());
+        let from_folder = run_propagate(
+            PropagateInput::Folder {
+                folder: shapes.clone(),
+                labels: vec![dir.path().join("s0.labels.txt")],
+            },
+            &job(Some(dir.path().join("out"))),
+        )
+        .unwrap();
+        let files: Vec<PathBuf> = (0..3).map(|i| shapes.join(format!("s{i}.off"))).collect();
+        let in_memory = run_propagate(
+            PropagateInput::Shapes {
+                shapes: files.iter().cloned().map(JobShape::File).collect(),
+                labels: vec![JobLabels::Vertex(labels), JobLabels::None, JobLabels::None],
+                part_names: Default::default(),
+            },
+            &job(None),
+        )
+        .unwrap();
+        let (a, b) = (&from_folder.result, &in_memory.result);
+        assert_eq!(a.graph.node_count(), 3);
+        assert_eq!(a.propagation.labels, b.propagation.labels);
+        assert!(a.propagation.labels[1].contains(&0));
+        assert!(a.propagation.labels[1].contains(&1));
+        assert!(in_memory.written.is_empty());
+        assert!(
+            from_folder
+                .written
+                .iter()
+                .any(|p| p.ends_with("summary.json"))
+        );
+        // The cache went beside the output, and into nothing without one.
+        assert!(dir.path().join("out/.cache").is_dir());
+        assert!(in_memory.cache_outcomes.iter().all(Option::is_none));
+    }
+
+    /// Annotations that do not fit their shapes fail before any per-shape work, naming the
+    /// shape; the map step needs a folder.
+    #[test]
+    fn bad_annotations_are_refused_naming_the_shape() {
+        let dir = tempfile::tempdir().unwrap();
+        let (shapes, _) = folder(dir.path());
+        let files: Vec<JobShape> = (0..3)
+            .map(|i| JobShape::File(shapes.join(format!("s{i}.off"))))
+            .collect();
+        let run = |labels: Vec<JobLabels>, job: &PropagateJob| {
+            run_propagate(
+                PropagateInput::Shapes {
+                    shapes: files.clone(),
+                    labels,
+                    part_names: Default::default(),
+                },
+                job,
+            )
+            .unwrap_err()
+        };
+        let e = run(
+            vec![
+                JobLabels::Vertex(vec![0, 1]),
+                JobLabels::None,
+                JobLabels::None,
+            ],
+            &job(None),
+        );
+        assert!(matches!(e, JobError::Invalid(_)), "{e}");
+        assert!(e.to_string().contains("s0"), "{e}");
+        let e = run(vec![JobLabels::None], &job(None));
+        assert!(
+            e.to_string().contains("1 label entries for 3 shapes"),
+            "{e}"
+        );
+        let e = run(vec![JobLabels::None; 3], &job(None));
+        assert!(matches!(e, JobError::Stage { .. }), "{e}");
+        let e = run(
+            vec![
+                JobLabels::File(dir.path().join("missing.labels.txt")),
+                JobLabels::None,
+                JobLabels::None,
+            ],
+            &job(None),
+        );
+        assert!(matches!(e, JobError::Labels(_)), "{e}");
+        assert!(e.to_string().contains("missing.labels.txt"), "{e}");
+        let mut with_map = job(None);
+        with_map.propagation.map_step = Some(Default::default());
+        let e = run(vec![JobLabels::None; 3], &with_map);
+        assert!(e.to_string().contains("map_step"), "{e}");
+    }
+}

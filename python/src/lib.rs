@@ -7,19 +7,15 @@ mod options;
 
 use coseg::cache::CacheOutcome;
 use coseg::graph::{ShapeNode, load_collection};
-use coseg::jobs::{CacheChoice, JobError, JobShape, PairJob, run_pair};
-use coseg::labels::{LabelKind, PartNames, read_part_names, read_shape_labels};
-use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
-use coseg::output::{
-    CollectionSummary, PropagationSummary, ShapeRegions, SkippedInput, write_propagation,
-    write_regions,
+use coseg::jobs::{
+    CacheChoice, JobError, JobLabels, JobShape, PairJob, PropagateInput, PropagateJob, run_pair,
+    run_propagate,
 };
+use coseg::labels::PartNames;
+use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
+use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions};
 use coseg::parts::{SegmentCollectionOptions, segment_collection};
 use coseg::pipeline::{ShapePipelineOptions, compute_shape_data, load_or_compute_bands};
-use coseg::propagate::{
-    PropagateCollectionOptions, PropagateError, PropagatedCollection, SourceFile,
-    propagate_collection, propagate_loaded,
-};
 use coseg::shape_task;
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 use numpy::ndarray::Array2;
@@ -52,8 +48,6 @@ fn lib_err_in(e: &(dyn std::error::Error + 'static), context: Option<&str>) -> P
     raise(if io { "FileError" } else { "InputError" }, message)
 }
 
-/// An error of a computation run without the GIL.
-type BoxError = Box<dyn std::error::Error + Send + Sync>;
 
 /// A `coseg.errors.<class>` exception with `message`.
 fn raise(class: &str, message: String) -> PyErr {
@@ -444,7 +438,7 @@ struct Loaded {
     outcomes: Vec<&'static str>,
 }
 
-fn outcome(o: &CacheOutcome) -> &'static str {
+fn outcome_name(o: &CacheOutcome) -> &'static str {
     match o {
         CacheOutcome::Hit => "hit",
         CacheOutcome::Miss => "miss",
@@ -471,7 +465,7 @@ fn load_arrays(
                             r.data.bands,
                             r.data.vertex_areas,
                             r.warnings,
-                            outcome(&r.outcome),
+                            outcome_name(&r.outcome),
                         )
                     }
                     None => {
@@ -518,7 +512,7 @@ fn load_folder(folder: &Path, pipe: &ShapePipelineOptions, cache: &Path) -> Resu
         nodes: c.nodes,
         skipped: c.skipped.iter().map(SkippedInput::from).collect(),
         warnings: c.warnings,
-        outcomes: c.outcomes.iter().map(outcome).collect(),
+        outcomes: c.outcomes.iter().map(outcome_name).collect(),
     })
 }
 
@@ -610,101 +604,26 @@ fn segment<'py>(
     Ok(d)
 }
 
-/// One shape's annotation as handed to `propagate`: none, per-vertex labels, or a label file.
-enum LabelInput {
-    None,
-    Array(Vec<i64>),
-    File(PathBuf),
-}
-
-fn label_inputs(list: &Bound<'_, PyList>) -> PyResult<Vec<LabelInput>> {
+/// One annotation per shape as handed to `propagate`: `None`, per-vertex labels, or a label
+/// file.
+fn label_inputs(list: &Bound<'_, PyList>) -> PyResult<Vec<JobLabels>> {
     let mut out = Vec::with_capacity(list.len());
     for (i, item) in list.iter().enumerate() {
         out.push(if item.is_none() {
-            LabelInput::None
+            JobLabels::None
         } else if let Ok(p) = item.extract::<PathBuf>() {
-            LabelInput::File(p)
+            JobLabels::File(p)
         } else {
             let a: numpy::PyReadonlyArray1<i64> = item.extract().map_err(|e| {
                 input_err(format!(
                     "labels {i}: expected a 1-D int64 array, a label file or None ({e})"
                 ))
             })?;
-            LabelInput::Array(a.as_array().to_vec())
+            JobLabels::Vertex(a.as_array().to_vec())
         });
     }
     Ok(out)
 }
-
-/// Per-shape vertex labels (`None`: unannotated), the sources among them, and warnings.
-type Annotations = (Vec<Option<Vec<i32>>>, Vec<SourceFile>, Vec<String>);
-
-/// The annotations of `shapes` (per vertex, `-1` = unlabelled) and the sources among them, or
-/// the error naming the shape whose labels do not fit it. An annotation without a labelled
-/// vertex is not used (a warning), as `coseg propagate` treats such a file.
-fn annotations_of(shapes: &[Shape], inputs: Vec<LabelInput>) -> Result<Annotations, BoxError> {
-    if inputs.len() != shapes.len() {
-        return Err(format!(
-            "{} label entries for {} shapes (give None for an unlabelled shape)",
-            inputs.len(),
-            shapes.len()
-        )
-        .into());
-    }
-    let mut annotations = Vec::with_capacity(shapes.len());
-    let mut sources = Vec::new();
-    let mut warnings = Vec::new();
-    for (i, (s, input)) in shapes.iter().zip(inputs).enumerate() {
-        let (labels, path, kind) = match input {
-            LabelInput::None => {
-                annotations.push(None);
-                continue;
-            }
-            LabelInput::File(path) => {
-                let l = read_shape_labels(&path, &s.mesh, &s.name)?;
-                (l.vertex_labels, path, l.kind)
-            }
-            LabelInput::Array(a) => {
-                let d = s.mesh.vertex_count();
-                if a.len() != d {
-                    return Err(format!(
-                        "labels of shape {i} ({}): {} labels for a mesh of {d} vertices",
-                        s.name,
-                        a.len()
-                    )
-                    .into());
-                }
-                let mut labels = Vec::with_capacity(d);
-                for (v, &x) in a.iter().enumerate() {
-                    let l = i32::try_from(x).map_err(|_| {
-                        format!(
-                            "labels of shape {i} ({}): vertex {v} has label {x}, outside the \
-                             32-bit label range",
-                            s.name
-                        )
-                    })?;
-                    labels.push(l.max(-1));
-                }
-                (labels, PathBuf::from(ARRAY_SOURCE), LabelKind::Vertex)
-            }
-        };
-        if labels.iter().all(|&l| l < 0) {
-            warnings.push(format!("{}: no labelled vertex, not used", s.name));
-            annotations.push(None);
-            continue;
-        }
-        sources.push(SourceFile {
-            shape: i,
-            path,
-            kind,
-        });
-        annotations.push(Some(labels));
-    }
-    Ok((annotations, sources, warnings))
-}
-
-/// The `label_file` of a source given as an array, in the summary.
-const ARRAY_SOURCE: &str = "<array>";
 
 /// Label propagation: `{"names", "labels", "confidence", "parts", "shape_confidence",
 /// "sources", "summary", "skipped", "warnings", "outcomes", "written"}`.
@@ -719,90 +638,49 @@ fn propagate<'py>(
     files: Option<Vec<Option<String>>>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let mut o = Opts::new(options);
-    let mut opts = PropagateCollectionOptions::default();
+    let mut job = PropagateJob::default();
+    let opts = &mut job.propagation;
     opts.pipeline = o.pipeline()?;
     let cache: Option<PathBuf> = o.take("cache_dir")?;
-    let out_dir: Option<PathBuf> = o.take("out")?;
-    let names_file: Option<PathBuf> = o.take("part_names")?;
+    job.output = o.take("out")?;
+    opts.part_names = o.take("part_names")?;
     let names_map: Option<PartNames> = o.take("part_names_map")?;
     (opts.graph, opts.propagate) = o.propagate()?;
     opts.map_step = o.map_step()?;
     o.finish()?;
-    let (result, outcomes) = if let Ok(list) = shapes.cast::<PyList>() {
-        if opts.map_step.is_some() {
-            return Err(input_err(
-                "map_step: the map step needs the shapes' spectra from a folder's cache; give a folder (shapes=PATH), not shapes in memory",
-            ));
+    // Python returns arrays; pictures are `coseg.render`'s.
+    job.pictures = false;
+    let input = if let Ok(list) = shapes.cast::<PyList>() {
+        job.cache = cache.map_or(CacheChoice::Off, CacheChoice::Dir);
+        PropagateInput::Shapes {
+            shapes: shapes_from(list, names, files)?
+                .into_iter()
+                .map(Shape::into_job_shape)
+                .collect(),
+            labels: label_inputs(&labels)?,
+            part_names: names_map.unwrap_or_default(),
         }
-        let list = shapes_from(list, names, files)?;
-        let inputs = label_inputs(&labels)?;
-        let pipe = opts.pipeline.clone();
-        py.detach(
-            || -> Result<(PropagatedCollection, Vec<&'static str>), BoxError> {
-                // The annotations first: bad labels fail before the per-shape stage runs.
-                let (annotations, sources, mut warnings) = annotations_of(&list, inputs)?;
-                if sources.is_empty() {
-                    return Err(PropagateError::NoLabels.into());
-                }
-                let part_names = match (&names_file, names_map) {
-                    (Some(p), _) => read_part_names(p)?,
-                    (None, Some(m)) => m,
-                    (None, None) => PartNames::new(),
-                };
-                let loaded = load_arrays(list, &pipe, cache.as_deref())?;
-                warnings.extend(loaded.warnings);
-                let solved = propagate_loaded(loaded.nodes, &loaded.meshes, &annotations, &opts)?;
-                warnings.extend(solved.warnings);
-                let n_shapes = loaded.meshes.len();
-                let result = PropagatedCollection {
-                    paths: loaded.files.iter().map(PathBuf::from).collect(),
-                    meshes: loaded.meshes,
-                    graph: solved.graph,
-                    smoothers: solved.smoothers,
-                    propagation: solved.propagation,
-                    sources,
-                    part_names,
-                    skipped: Vec::new(),
-                    // Shapes in memory: `outcomes` below says where their data came from.
-                    outcomes: Vec::new(),
-                    // The map step needs the shapes' spectra from the folder path's cache;
-                    // arrays in memory do not run it.
-                    map_steps: vec![None; n_shapes],
-                    map_step: None,
-                    fusion: solved.fusion,
-                    warnings,
-                };
-                Ok((result, loaded.outcomes))
-            },
-        )
-        .map_err(|e| lib_err(&*e))?
     } else {
-        let folder: PathBuf = shapes.extract()?;
-        let files: Vec<PathBuf> = labels.extract()?;
         if names_map.is_some() {
             return Err(input_err(
                 "part names of a folder come from a file (part_names=PATH)",
             ));
         }
-        opts.part_names = names_file;
-        opts.cache_dir = cache.or_else(|| out_dir.as_ref().map(|o| o.join(".cache")));
-        let context = format!("propagating labels over {}", folder.display());
-        let result = py
-            .detach(|| propagate_collection(&folder, &files, &opts))
-            .map_err(|e| lib_err_in(&e, Some(&context)))?;
-        let outcomes = result.outcomes.iter().map(outcome).collect();
-        (result, outcomes)
+        job.cache = cache.map_or(CacheChoice::Auto, CacheChoice::Dir);
+        PropagateInput::Folder {
+            folder: shapes.extract()?,
+            labels: labels.extract()?,
+        }
     };
-    if result.graph.node_count() == 0 {
-        return Err(input_err("no readable mesh"));
-    }
-    let summary = PropagationSummary::of(&result, &opts.graph, &opts.propagate);
-    let written = match &out_dir {
-        Some(dir) => py
-            .detach(|| write_propagation(dir, &result, &summary))
-            .or_raise()?,
-        None => Vec::new(),
-    };
+    let outcome = py
+        .detach(|| run_propagate(input, &job))
+        .map_err(|e| lib_err(&e))?;
+    let (result, summary) = (&outcome.result, &outcome.summary);
+    let outcomes: Vec<&str> = outcome
+        .cache_outcomes
+        .iter()
+        .map(|o| o.as_ref().map_or("computed", outcome_name))
+        .collect();
     let p = &result.propagation;
     let n = result.graph.node_count();
     let d = PyDict::new(py);
@@ -826,12 +704,12 @@ fn propagate<'py>(
         PyArray1::from_slice(py, &p.shape_confidence),
     )?;
     d.set_item("sources", summary.sources.clone())?;
-    d.set_item("summary", json(py, &summary)?)?;
+    d.set_item("summary", json(py, summary)?)?;
     let skipped: Vec<SkippedInput> = result.skipped.iter().map(SkippedInput::from).collect();
     d.set_item("skipped", json(py, &skipped)?)?;
     d.set_item("warnings", result.warnings.clone())?;
     d.set_item("outcomes", outcomes)?;
-    d.set_item("written", written)?;
+    d.set_item("written", outcome.written.clone())?;
     Ok(d)
 }
 

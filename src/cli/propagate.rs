@@ -1,15 +1,11 @@
 //! `coseg propagate FOLDER --labels DIR-OR-FILES -o OUT`: part labels from a few annotated
 //! shapes to every mesh of a folder.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
 use coseg::graph::GraphOptions;
-use coseg::labels::PartNames;
-use coseg::output::{PropagationSummary, write_propagation, write_visuals};
-use coseg::propagate::{
-    MapStepOptions, PartScore, PropagateCollectionOptions, PropagateOptions, propagate_collection,
-};
-use coseg::render::{RenderOptions, RenderShape};
+use coseg::jobs::{CacheChoice, PropagateInput, PropagateJob, run_propagate};
+use coseg::propagate::{MapStepOptions, PartScore, PropagateOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -85,9 +81,10 @@ pub struct PropagateArgs {
     pipeline: super::pipeline_args::PipelineArgs,
 }
 
-pub fn run(args: PropagateArgs) -> Result<ExitCode> {
-    let t0 = Instant::now();
-    let mut options = PropagateCollectionOptions::default();
+/// The job `coseg propagate` runs with these flags (the flags translated, nothing else).
+fn propagate_job(args: &PropagateArgs) -> Result<PropagateJob> {
+    let mut job = PropagateJob::default();
+    let options = &mut job.propagation;
     options.pipeline = args.pipeline.options()?;
     options.graph.complete_limit = args.complete_limit;
     options.graph.neighbours = args.neighbours;
@@ -109,14 +106,32 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
         m.min_agreement = args.map_agreement;
         options.map_step = Some(m);
     }
-    options.cache_dir = Some(
-        args.cache
-            .clone()
-            .unwrap_or_else(|| args.out.join(".cache")),
-    );
     options.part_names = args.part_names.clone();
-    let result = propagate_collection(&args.folder, &args.labels, &options)
-        .with_context(|| format!("propagating labels over {}", args.folder.display()))?;
+    job.cache = args
+        .cache
+        .clone()
+        .map_or(CacheChoice::Auto, CacheChoice::Dir);
+    job.output = Some(args.out.clone());
+    job.pictures = !args.no_pictures;
+    Ok(job)
+}
+
+pub fn run(args: PropagateArgs) -> Result<ExitCode> {
+    let t0 = Instant::now();
+    let job = propagate_job(&args)?;
+    let spin = super::spinner("propagating");
+    let outcome = run_propagate(
+        PropagateInput::Folder {
+            folder: args.folder.clone(),
+            labels: args.labels.clone(),
+        },
+        &job,
+    );
+    if let Some(b) = spin {
+        b.finish_and_clear();
+    }
+    let outcome = outcome?;
+    let result = &outcome.result;
     for s in &result.skipped {
         eprintln!("error: {} (skipped)", s.error);
     }
@@ -125,35 +140,8 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
     }
     super::check_strict(result.skipped.len())?;
     let n = result.graph.node_count();
-    if n == 0 {
-        bail!("{}: no readable mesh", args.folder.display());
-    }
-    let t_solve = t0.elapsed();
-    let summary = PropagationSummary::of(&result, &options.graph, &options.propagate);
-    let mut written = write_propagation(&args.out, &result, &summary)?;
+    let written = &outcome.written;
     let p = &result.propagation;
-    if !args.no_pictures {
-        let spin = super::spinner("pictures");
-        let pictures: Vec<RenderShape> = (0..n)
-            .map(|i| RenderShape {
-                name: &result.graph.node(i).name,
-                mesh: &result.meshes[i],
-                labels: &p.labels[i],
-                confidence: Some(p.shape_confidence[i]),
-            })
-            .collect();
-        // The legends index names by label value; labels are the annotation's own integers.
-        let names = legend_names(&p.parts, &result.part_names);
-        written.extend(write_visuals(
-            &args.out,
-            &pictures,
-            (!result.part_names.is_empty()).then_some(names.as_slice()),
-            &RenderOptions::default(),
-        )?);
-        if let Some(b) = spin {
-            b.finish_and_clear();
-        }
-    }
     if super::quiet() {
         return Ok(super::exit_code(
             result.skipped.len(),
@@ -180,22 +168,32 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
             order.iter().map(|&i| p.shape_confidence[i]).sum::<f64>() / order.len() as f64
         );
     }
-    println!(
-        "time: load + propagate {:.2} s, total {:.2} s",
-        t_solve.as_secs_f64(),
-        t0.elapsed().as_secs_f64()
-    );
+    println!("time: total {:.2} s", t0.elapsed().as_secs_f64());
     Ok(super::exit_code(
         result.skipped.len(),
         n + result.skipped.len(),
     ))
 }
 
-/// Legend text per label value `0..=max`: the part's name when given, else empty (the legend
-/// then shows the bare label).
-fn legend_names(parts: &[i32], names: &PartNames) -> Vec<String> {
-    let max = parts.iter().copied().max().unwrap_or(-1).max(-1);
-    (0..=max)
-        .map(|l| names.get(&l).cloned().unwrap_or_default())
-        .collect()
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: PropagateArgs,
+    }
+
+    /// The bare command runs the job's default: the CLI chooses no default of its own.
+    #[test]
+    fn the_bare_command_runs_the_default_job() {
+        let cli = Cli::parse_from(["coseg", "shapes", "--labels", "a.seg", "-o", "out"]);
+        let job = propagate_job(&cli.args).unwrap();
+        let mut want = PropagateJob::default();
+        want.output = Some(PathBuf::from("out"));
+        want.pictures = true;
+        assert_eq!(format!("{job:?}"), format!("{want:?}"));
+    }
 }

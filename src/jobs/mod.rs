@@ -4,6 +4,9 @@
 //! Entry points:
 //! - [`run_pair`]`([`[`JobShape`]`; 2], &`[`PairJob`]`) -> Result<`[`PairOutcome`]`, `[`JobError`]`>`:
 //!   `coseg pair` and `coseg.pair`;
+//! - [`run_propagate`]`(`[`PropagateInput`]`, &`[`PropagateJob`]`) -> Result<`[`PropagateOutcome`]`, `[`JobError`]`>`:
+//!   `coseg propagate` and `coseg.propagate` (a folder with label files, or shapes with one
+//!   annotation each, [`JobLabels`]);
 //! - [`run_eval`]`(result, truth, &`[`EvalJob`]`) -> Result<`[`FolderScores`](crate::evaluate::FolderScores)`, `[`JobError`]`>`:
 //!   `coseg eval`;
 //! - [`align_folder`](crate::align::align_folder) (`coseg align`) lives with its stage.
@@ -17,9 +20,13 @@
 
 mod eval_job;
 mod pair_job;
+mod propagate_job;
 
 pub use eval_job::{EvalJob, run_eval};
 pub use pair_job::{PairJob, PairOutcome, run_pair};
+pub use propagate_job::{
+    ARRAY_SOURCE, JobLabels, PropagateInput, PropagateJob, PropagateOutcome, run_propagate,
+};
 
 use crate::mesh::TriMesh;
 use crate::pipeline::{LoadedShape, PipelineError, ShapeContent, ShapePipelineOptions};
@@ -50,6 +57,10 @@ pub enum JobError {
         #[source]
         source: Box<dyn std::error::Error + Send + Sync>,
     },
+    /// A label or part-names file could not be read, or does not fit its shape (the message
+    /// names the file).
+    #[error(transparent)]
+    Labels(#[from] crate::labels::LabelError),
     /// Writing the outputs failed.
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
@@ -97,6 +108,24 @@ impl JobShape {
         }
     }
 
+    /// The shape's name, the file it came from (when known) and its mesh: a file is read
+    /// (its reader's warnings returned, prefixed by its path), a mesh is returned as it is.
+    fn read(self) -> Result<ReadShape, JobError> {
+        let name = self.name();
+        match self {
+            JobShape::File(path) => {
+                let (mesh, report) = crate::mesh::read_mesh_with_report(&path)?;
+                let warnings = report
+                    .warnings
+                    .iter()
+                    .map(|w| format!("{}: {w}", path.display()))
+                    .collect();
+                Ok((name, Some(path), mesh, warnings))
+            }
+            JobShape::Mesh { file, mesh, .. } => Ok((name, file, mesh, Vec::new())),
+        }
+    }
+
     /// The shape through the per-shape stage (and `cache`).
     fn load<T: ShapeContent>(
         self,
@@ -118,6 +147,9 @@ impl JobShape {
         })
     }
 }
+
+/// A shape read by [`JobShape::read`]: name, file, mesh, the reader's warnings.
+type ReadShape = (String, Option<PathBuf>, TriMesh, Vec<String>);
 
 /// Where a job keeps its per-shape cache.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
