@@ -111,6 +111,30 @@ fn fusion_is_deterministic_and_in_range() {
     assert!(first.agreement[1].iter().all(|a| (0.0..=1.0).contains(a)));
 }
 
+/// Regression: a route at chance got a log-odds weight a hair below 0 by rounding, its votes
+/// negative scores, and the fused confidence `(best − second) / Σ scores` a hair above 1
+/// (`coseg.propagate`'s confidences failed their `[0, 1]` check on the shipped goblets).
+#[test]
+fn a_route_worse_than_chance_gets_no_weight_and_confidences_stay_in_range() {
+    let d = 600;
+    let (truth, a) = truth_and_noisy(d, 0.05, 11);
+    let (_, b) = truth_and_noisy(d, 0.05, 12);
+    // Every label moved to the next: it agrees with the others below chance.
+    let c: Vec<i32> = truth.iter().map(|&l| (l + 1) % 3).collect();
+    let routes = [route(a, 0.5), route(b, 0.5), route(c, 0.5)];
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas: [Vec<f64>; 2] = [vec![1.0; 3], vec![1.0; d]];
+    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
+    let fused = fuse_routes(&refs, &area_refs);
+    assert_eq!(fused.weights[1][2], 0.0, "{:?}", fused.weights[1]);
+    assert!(
+        fused.confidence[1].iter().all(|c| (0.0..=1.0).contains(c)),
+        "{:?}",
+        fused.confidence[1].iter().copied().fold(f64::MIN, f64::max)
+    );
+    assert!(accuracy(&fused.labels[1], &truth) > 0.9);
+}
+
 #[test]
 fn parts_are_named_by_the_sources_majority_and_unknown_parts_say_so() {
     // Two shapes of 6 vertices, three tuples: {0,1}, {2,3}, {4,5} on both. The source

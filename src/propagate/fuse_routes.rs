@@ -256,7 +256,7 @@ pub fn fuse_routes_with(
                 let second = scores.get(1).map_or(0.0, |s| s.1);
                 labels[v] = l;
                 conf[v] = if sum > 0.0 {
-                    (best - second) / sum
+                    ((best - second) / sum).clamp(0.0, 1.0)
                 } else {
                     0.0
                 };
@@ -376,7 +376,9 @@ fn route_kappas(kappa: &[Vec<f64>]) -> Vec<f64> {
 fn log_odds(kappa: f64, labels: usize) -> f64 {
     let l = labels.max(2) as f64;
     let p = 1.0 / l + kappa.clamp(0.0, MAX_KAPPA) * (1.0 - 1.0 / l);
-    (p * (l - 1.0) / (1.0 - p)).ln()
+    // At chance (κ = 0) the log-odds is 0 up to rounding; a weight a hair below 0 turned its
+    // votes into negative scores and the fused confidence above 1.
+    (p * (l - 1.0) / (1.0 - p)).ln().max(0.0)
 }
 
 /// Sets the level of each route's per-shape κ to its held-out accuracy (`held_out[r]`, an
