@@ -606,7 +606,7 @@ fn shared_failure_vote(
         if let Some((k, q)) = best {
             out[v] = k;
             conf[v] = if total > 0.0 {
-                (q - second) / total
+                ((q - second) / total).clamp(0.0, 1.0)
             } else {
                 0.0
             };
