@@ -51,7 +51,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
     // Region tuples across the family, then boundary refinement over every graph edge (the
     // defaults); and, for comparison, the raw tuples.
-    let options = SegmentCollectionOptions::default();
+    let options = SegmentCollectionOptions::equal_areas(6);
     let refined = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?.segmentation;
     let raw = {
         let mut opts = options;

@@ -4,6 +4,8 @@
 //! ```text
 //! cargo run --release --example bench_segment -- [--cache DIR] [--regions K] [--refine-rounds N] MESH...
 //! ```
+//! Without `--regions`: the bare `coseg segment` (parts from geometry, their number and the
+//! feature families chosen from the data); `--regions K`: K equal-area regions.
 //! Cold: every shape's spectrum, descriptors and bands are computed (shapes in parallel) and
 //! written to an emptied cache folder (default `/tmp/coseg-bench-cache`); then
 //! [`segment_collection`] runs with `coseg segment`'s defaults (graph, co-segmentation, heat
@@ -32,7 +34,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         match a.as_str() {
             "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),
             "--regions" => {
-                seg_opts.cosegment.regions = args.next().ok_or("--regions K")?.parse()?
+                let refine = seg_opts.refine;
+                seg_opts = SegmentCollectionOptions::equal_areas(
+                    args.next().ok_or("--regions K")?.parse()?,
+                );
+                seg_opts.refine = refine;
             }
             "--refine-rounds" => {
                 let rounds: usize = args.next().ok_or("--refine-rounds N")?.parse()?;
@@ -140,14 +146,22 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
 
 fn stages(t: &SegmentTimes) -> String {
     format!(
-        "graph {:.2} s, co-segmentation {:.2} s, smoothers {:.2} s, refinement {:.2} s",
+        "feature choice {:.2} s, graph {:.2} s, co-segmentation {:.2} s (part cues {:.2} s), smoothers {:.2} s, refinement {:.2} s",
+        t.features.unwrap_or_default().as_secs_f64(),
         t.graph.as_secs_f64(),
         t.cosegment.as_secs_f64(),
+        t.part_cues.unwrap_or_default().as_secs_f64(),
         t.smoothers.as_secs_f64(),
         t.refine.as_secs_f64()
     )
 }
 
 fn total(t: &SegmentTimes) -> f64 {
-    (t.graph + t.cosegment + t.smoothers + t.refine).as_secs_f64()
+    (t.features.unwrap_or_default()
+        + t.graph
+        + t.part_cues.unwrap_or_default()
+        + t.cosegment
+        + t.smoothers
+        + t.refine)
+        .as_secs_f64()
 }

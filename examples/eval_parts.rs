@@ -15,6 +15,9 @@
 //! (region × grouped part, % of a shape) and the best any grouping of the regions could score;
 //! for the part modes the same for the leaves, the merge tree and, when regions were split into
 //! their pieces, each leaf's region of origin.
+//! `--features auto` chooses the families from the data (`coseg segment` without
+//! `--features`); the mode `default` is the bare `coseg segment` (parts from geometry, their
+//! number chosen from the part tree).
 //! `FOLDER` is either a COSEG-style set (`shapes/N.off` and `gt/N.seg`, one label per face) or a
 //! shipped family (`collections/<family>`, per-vertex labels and a manifest). Each `MODE` is
 //! `fixed:R` (`cosegment`, R equal-area regions, today's `coseg segment --regions R`), `auto`
@@ -213,7 +216,11 @@ fn mirror_check(
 }
 
 fn options(mode: &str, refine_rounds: usize, starts: usize) -> Res<SegmentCollectionOptions> {
-    let mut o = SegmentCollectionOptions::default();
+    let mut o = if mode == "default" {
+        SegmentCollectionOptions::default()
+    } else {
+        SegmentCollectionOptions::equal_areas(coseg::graph::CosegmentOptions::default().regions)
+    };
     // Several starts are for the equal-area mode only (segment_collection refuses them with
     // --parts).
     if mode.starts_with("fixed:") {
@@ -231,7 +238,7 @@ fn options(mode: &str, refine_rounds: usize, starts: usize) -> Res<SegmentCollec
     };
     if let Some(r) = mode.strip_prefix("fixed:") {
         o.cosegment.regions = r.parse()?;
-    } else {
+    } else if mode != "default" {
         let mut a = AdaptiveOptions::default();
         if let Some(k) = mode.strip_prefix("parts:") {
             a.parts = Some(k.parse()?);
@@ -260,6 +267,7 @@ fn main() -> Res<()> {
     let mut mirrors = false;
     let mut parts_from = None;
     let mut snap_band: Option<f64> = None;
+    let mut family_weights = String::new();
     while let Some(a) = args.next() {
         match a.as_str() {
             "--features" => features = args.next().ok_or("--features F")?,
@@ -277,6 +285,7 @@ fn main() -> Res<()> {
             }
             "--keep-sizes" => keep = Some(args.next().ok_or("--keep-sizes TOL")?.parse()?),
             "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),
+            "--family-weights" => family_weights = args.next().ok_or("--family-weights W")?,
             "--snap-band" => snap_band = Some(args.next().ok_or("--snap-band W")?.parse()?),
             "--refine-rounds" => refine_rounds = args.next().ok_or("--refine-rounds N")?.parse()?,
             _ => modes.push(a),
@@ -290,7 +299,14 @@ fn main() -> Res<()> {
     };
     let mut pipeline = ShapePipelineOptions::default();
     let directions = coseg::features::ExtrinsicOptions::default().directions;
-    pipeline.set_families(&features, &up, directions, normals, "")?;
+    // `auto`: the families chosen from the data, as `coseg segment` without `--features`.
+    let chosen = features == "auto";
+    let given = if chosen {
+        "spectral"
+    } else {
+        features.as_str()
+    };
+    pipeline.set_families(given, &up, directions, normals, &family_weights)?;
     let loaded = load_collection(&shapes, &pipeline, &cache, |_, _, _| {})?;
     if mirrors {
         let errors: Vec<String> = loaded
@@ -307,6 +323,9 @@ fn main() -> Res<()> {
     }
     for mode in &modes {
         let mut o = options(mode, refine_rounds, starts)?;
+        if !chosen {
+            o.features = coseg::parts::FeatureSelection::Given;
+        }
         o.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
         o.group_mirrors = mirrors;
         if let (Some(from), Some(_)) = (parts_from, &o.parts) {
@@ -329,6 +348,19 @@ fn main() -> Res<()> {
         let out = segment_collection(loaded.nodes.clone(), &loaded.meshes, &o)?;
         let secs = t.elapsed().as_secs_f64();
         let seg = &out.segmentation;
+        if let Some(f) = &out.features {
+            println!("  {}", f.reason);
+        }
+        if let Some(c) = &out.part_count {
+            println!(
+                "  {} costs {:?}",
+                c.reason,
+                c.costs
+                    .iter()
+                    .map(|x| (100.0 * x).round() / 100.0)
+                    .collect::<Vec<_>>()
+            );
+        }
         let sizes: Vec<String> = seg
             .tuples
             .iter()
@@ -357,6 +389,14 @@ fn main() -> Res<()> {
                     .collect::<Vec<_>>(),
                 a.stop,
                 a.auto.iter().map(|x| x.t).collect::<Vec<_>>()
+            ) + &format!(
+                " leafconf {:.3} costs {:?}",
+                coseg::parts::start_score(&a.leaves),
+                a.tree
+                    .merges
+                    .iter()
+                    .map(|m| (-m.similarity.ln() * 100.0).round() / 100.0)
+                    .collect::<Vec<_>>()
             )
         });
         if mirrors && !coseg_set {

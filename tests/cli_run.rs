@@ -231,7 +231,7 @@ fn refine_sizes_is_recorded_and_checked() {
 
 /// `--parts N --parts-from geometry`: N parts cut from `--regions` equal-area regions,
 /// recorded in summary.json (the option, the stop reason, the leaves); `--parts auto` and no
-/// `--parts` are refused with a message, as is an unknown kind.
+/// `--parts` choose the number and record it; an unknown kind is refused.
 #[test]
 fn parts_from_geometry_is_recorded_and_checked() {
     let dir = tempfile::tempdir().unwrap();
@@ -308,16 +308,29 @@ fn parts_from_geometry_is_recorded_and_checked() {
     assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
     assert_eq!(std::fs::read(&cues[0]).unwrap(), good);
     assert_eq!(std::fs::read(out.join("s0.regions.txt")).unwrap(), regions);
+    // Without a number (`--parts auto`, or no `--parts`: the default), the part tree's cut
+    // criterion chooses one, recorded with its reason.
     for (name, extra) in [
         ("auto", &["--parts", "auto", "--parts-from", "geometry"][..]),
         ("noparts", &["--parts-from", "geometry"][..]),
     ] {
-        let (run, _) = run_with(name, extra);
-        assert_ne!(run.status.code(), Some(0), "{name}");
+        let (run, out) = run_with(name, extra);
+        assert_eq!(run.status.code(), Some(0), "{name}: {}", text(&run.stderr));
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        let count = summary["part_count"]["count"].as_u64().unwrap() as usize;
+        assert_eq!(
+            summary["regions"].as_array().unwrap().len(),
+            count,
+            "{name}"
+        );
         assert!(
-            text(&run.stderr).contains("number of parts"),
-            "{name}: {}",
-            text(&run.stderr)
+            summary["part_count"]["reason"]
+                .as_str()
+                .unwrap()
+                .contains("parts"),
+            "{name}"
         );
     }
     let (run, _) = run_with(

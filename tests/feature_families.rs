@@ -431,8 +431,7 @@ fn a_collection_mixing_families_is_deterministic_bit_for_bit() {
             })
             .collect();
         let features = nodes[0].bands.features;
-        let mut s = SegmentCollectionOptions::default();
-        s.cosegment.regions = 3;
+        let mut s = SegmentCollectionOptions::equal_areas(3);
         s.feature_weights = o.feature_weights(features);
         assert!(s.feature_weights.is_some());
         let out = segment_collection(nodes.clone(), &meshes, &s).unwrap();

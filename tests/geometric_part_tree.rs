@@ -9,8 +9,9 @@ use coseg::cache::CacheOutcome;
 use coseg::graph::{Cosegmentation, GraphError, ShapeNode};
 use coseg::mesh::TriMesh;
 use coseg::parts::{
-    PartCues, PartsFrom, SegmentCollectionOptions, StopReason, geometric_part_tree,
-    geometric_part_tree_with_cues, load_or_compute_part_cues, segment_collection,
+    FeatureSelection, PartCues, PartsFrom, SegmentCollectionOptions, StopReason,
+    geometric_part_tree, geometric_part_tree_with_cues, load_or_compute_part_cues,
+    segment_collection,
 };
 
 /// A column of octagonal rings along y, ring `k` at height `0.5 k` with radius `radius(k)`,
@@ -151,6 +152,8 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
         })
         .collect();
     let mut o = SegmentCollectionOptions::default();
+    // The height bands as they are (not the feature families chosen from the data).
+    o.features = FeatureSelection::Given;
     o.request_parts(coseg::parts::PartsRequest::Count(2), None);
     o.set_parts_from("geometry".parse().unwrap(), Some(6));
     // The tree's cut as it is: the boundary snapping is tested on its own.
@@ -184,18 +187,22 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
         assert!(run.warnings.is_empty(), "{:?}", run.warnings);
         assert_eq!(cue_entries(dir.path()), 3);
     }
-    // A number of parts is needed, and enough regions to make them.
+    // Without a number of parts, the tree's cut criterion chooses one and says why.
     o.request_parts(coseg::parts::PartsRequest::Auto, None);
-    assert!(matches!(
-        segment_collection(nodes.clone(), &meshes, &o),
-        Err(GraphError::BadOption(_))
-    ));
+    let auto = segment_collection(nodes.clone(), &meshes, &o).unwrap();
+    let count = auto.part_count.as_ref().unwrap();
+    assert!((2..=8).contains(&count.count), "{count:?}");
+    assert_eq!(auto.segmentation.tuples.len(), count.count);
+    assert!(out.part_count.is_none(), "a number was given");
+    // Enough regions to make the parts asked for.
     o.request_parts(coseg::parts::PartsRequest::Count(8), None);
     assert!(matches!(
         segment_collection(nodes.clone(), &meshes, &o),
         Err(GraphError::BadOption(_))
     ));
-    let mut none = SegmentCollectionOptions::default();
+    // Parts from geometry without parts (equal-area regions) are refused.
+    let mut none = SegmentCollectionOptions::equal_areas(6);
+    none.features = FeatureSelection::Given;
     none.parts_from = PartsFrom::Geometry {
         leaves: 6,
         band: PartsFrom::GEOMETRY_BAND,

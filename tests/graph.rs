@@ -686,11 +686,12 @@ fn segment_collection_is_cosegment_then_refinement() {
     let (tables, areas) = noisy_collection(4, d, 11);
     let meshes = vec![mesh; 4];
     let mut opts = {
-        let mut opts = SegmentCollectionOptions::default();
+        let mut opts = SegmentCollectionOptions::equal_areas(4);
         opts.refine = None;
+        // The nodes' columns as they are (not the feature families chosen from the data).
+        opts.features = coseg::parts::FeatureSelection::Given;
         opts
     };
-    opts.cosegment.regions = 4;
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &opts.graph).unwrap();
     let raw = cosegment(&g, &opts.cosegment).unwrap();
     let out = segment_collection(nodes_from(&tables, &areas), &[], &opts).unwrap();
@@ -724,8 +725,8 @@ fn segment_collection_keeps_the_start_of_highest_confidence() {
     let d = mesh.vertex_count();
     let (tables, areas) = noisy_collection(4, d, 5);
     let meshes = vec![mesh; 4];
-    let mut opts = SegmentCollectionOptions::default();
-    opts.cosegment.regions = 4;
+    let mut opts = SegmentCollectionOptions::equal_areas(4);
+    opts.features = coseg::parts::FeatureSelection::Given;
     opts.refine = Some({
         let mut r = RefineOptions::default();
         r.max_rounds = 3;
@@ -794,9 +795,9 @@ fn start_score_of_a_single_part_is_zero() {
     let d = mesh.vertex_count();
     let (tables, areas) = noisy_collection(4, d, 5);
     let meshes = vec![mesh; 4];
-    let mut opts = SegmentCollectionOptions::default();
+    let mut opts = SegmentCollectionOptions::equal_areas(1);
+    opts.features = coseg::parts::FeatureSelection::Given;
     opts.refine = None;
-    opts.cosegment.regions = 1;
     let one = segment_collection(nodes_from(&tables, &areas), &meshes, &opts).unwrap();
     assert_eq!(one.segmentation.tuples.len(), 1);
     assert!(one.segmentation.tuples[0].confidence > 0.99);

@@ -426,7 +426,7 @@ def segment(
     parts: Optional[Union[str, int]] = None,
     starts: int = _D["starts"],
     refine_sizes: str = _D["refine_sizes"],
-    parts_from: str = _D["parts_from"],
+    parts_from: Optional[str] = None,
     snap_band: Optional[float] = None,
     area_fraction: Optional[float] = _D["area_fraction"],
     seed: Optional[int] = _D["segment_seed"],
@@ -440,7 +440,7 @@ def segment(
     curvature: int = _D["curvature"],
     bands: int = _D["bands"],
     area_bands: bool = _D["area_bands"],
-    families: Union[str, Sequence[str]] = _D["features"],
+    families: Optional[Union[str, Sequence[str]]] = None,
     up: str = _D["up"],
     directions: int = _D["directions"],
     family_weights: Any = None,
@@ -457,27 +457,32 @@ def segment(
     ``"computed"`` without one) and ``written`` (files written to ``out``, if given: the
     CLI's region files).
 
-    Options (defaults as ``coseg segment``): ``regions`` (6) regions per shape, the last the
-    leftovers; ``parts`` (None): parts of their own size instead of equal areas (Algorithm 3
-    across the collection, docs/PARTS.md), ``"auto"`` for as many as are stable and
-    consistent or an integer N to cut the tree of parts at N, ``regions`` then being the
-    upper bound (default 8) and ``summary["parts"]`` the thresholds, sizes, tree, mirror
-    candidates (regions holding both sides) and mirror pairs (regions that are left/right
-    copies, ``mirror_pairs``); ``starts`` (1): co-segment from this many starts and keep the one of highest
-    mean confidence (equal-area mode only: with ``parts`` it raises :class:`InputError`); ``refine_sizes`` (``"free"``): ``"keep"`` or
-    ``"keep:TOL"`` keeps each part's area within a factor 1 + TOL (default 0.5) of its
-    area before refinement (meant for ``parts``); ``parts_from`` (``"adaptive"``): with
-    ``parts=N``, ``"geometry"`` takes ``regions`` (default 12) equal-area regions and groups
-    touching ones (and left/right copies) of one thickness across convex boundaries (``--parts-from geometry``,
+    Options (defaults as ``coseg segment``; by default the result is parts, their number and
+    the feature families chosen from the data, docs/PARTS.md, and ``summary["part_count"]``
+    and ``summary["features"]`` say what was chosen and why): ``regions`` alone: that many
+    equal-area regions per shape instead, the last the leftovers (the paper's stable regions);
+    ``parts`` (None: ``"auto"``): an integer N cuts the tree of parts at N, ``"auto"`` lets
+    the tree's cut criterion choose; ``parts_from`` (None: ``"geometry"``): ``"geometry"``
+    takes ``regions`` (default 12) refined equal-area regions and groups touching ones (and
+    left/right copies) of one thickness across convex boundaries (``--parts-from geometry``,
     docs/PARTS.md; a region made of separate pieces of different parts is split first, and
     pieces split from one region that face the same way are grouped as copies of one part:
-    ``summary["parts"]["leaf_origin"]``, ``["leaf_copies"]``), then moves each part boundary onto a concave crease within ``snap_band``
-    (None: 0.1) × √(shape area) (``--snap-band``; 0 keeps the regions' boundaries); ``area_fraction`` (None: 1 / regions) of
+    ``summary["parts"]["leaf_origin"]``, ``["leaf_copies"]``), then moves each part boundary
+    onto a concave crease within ``snap_band`` (None: 0.1) × √(shape area) (``--snap-band``;
+    0 keeps the regions' boundaries); ``"adaptive"``: parts of their own size (Algorithm 3
+    across the collection), ``regions`` then being the upper bound (default 8);
+    ``summary["parts"]`` holds the tree, mirror candidates (regions holding both sides) and
+    mirror pairs (regions that are left/right copies, ``mirror_pairs``); ``families`` (None:
+    ``"spectral"`` or ``"spectral,extrinsic"`` in the collection frame, chosen from the data;
+    given, the families as given); ``starts`` (1): co-segment from this many starts and keep
+    the one of highest mean confidence (equal-area mode only: with parts it raises
+    :class:`InputError`); ``refine_sizes`` (``"free"``): ``"keep"`` or ``"keep:TOL"`` keeps
+    each part's area within a factor 1 + TOL (default 0.5) of its area before refinement;
+    ``area_fraction`` (None: 1 / regions) of
     each region; ``seed`` (None: start from the most distinctive vertex); ``complete_limit``
     (12): collections up to this size use a complete shape graph, larger ones ``neighbours``
     (6) nearest neighbours; ``refine_rounds`` (boundary refinement sweeps, 0 = none) and
-    ``smoothing_time``. Recommended for aligned collections: ``families="spectral,extrinsic",
-    up=..., normals=16``.
+    ``smoothing_time``.
     ``cache_dir``: per-shape cache (for a folder, default ``<out>/.cache``, as the CLI, or
     ``<folder>/.cache`` without ``out``; for a list, none unless given). Fill it on a
     cluster with :func:`coseg.dask.precompute`.
@@ -499,8 +504,12 @@ def segment(
         smoothing_time=smoothing_time,
         cache_dir=_path(cache_dir),
         out=_path(out),
-        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights, normals),
+        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands,
+                _D["features"] if families is None else families, up, directions, family_weights, normals),
     )
+    if families is None:
+        # As `coseg segment` without --features: the library chooses the families.
+        opts["features"] = None
     if isinstance(shapes, (str, os.PathLike)):
         if names is not None:
             raise InputError("names: a folder's shapes are named by file stem")

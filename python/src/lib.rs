@@ -526,6 +526,11 @@ fn segment<'py>(
     options: Option<Bound<'py, PyDict>>,
     files: Option<Vec<Option<String>>>,
 ) -> PyResult<Bound<'py, PyDict>> {
+    // As `coseg segment`: without `features` the library chooses the families from the data.
+    let features_given = match &options {
+        Some(d) => d.get_item("features")?.is_some_and(|v| !v.is_none()),
+        None => false,
+    };
     let mut o = Opts::new(options);
     let pipe = o.pipeline()?;
     let cache: Option<PathBuf> = o.take("cache_dir")?;
@@ -567,10 +572,8 @@ fn segment<'py>(
         warnings,
         outcomes,
     } = loaded;
-    // As `coseg segment`: the families' weights over the table's columns.
-    seg_opts.feature_weights = pipe.feature_weights(nodes[0].bands.features);
-    seg_opts.up = pipe.up_direction();
-    seg_opts.mirror_columns = pipe.mirror_invariant_columns(nodes[0].bands.features);
+    // As `coseg segment`: the given families, or the families chosen from the data.
+    seg_opts.set_pipeline(&pipe, features_given, nodes[0].bands.features);
     let result = py
         .detach(|| segment_collection(nodes, &meshes, &seg_opts))
         .or_raise()?;

@@ -162,55 +162,51 @@ impl<'py> Opts<'py> {
 
     /// The collection stage's options, as `coseg segment` sets them.
     pub fn segment(&mut self) -> PyResult<SegmentCollectionOptions> {
-        let d = SegmentCollectionOptions::default();
-        let mut graph = GraphOptions::default();
-        let mut cos = CosegmentOptions::default();
-        cos.area_fraction = self.take("area_fraction")?;
-        cos.seed = self.take("seed")?;
+        let lib = |e: GraphError| super::lib_err(&e);
+        let regions: Option<usize> = self.take("regions")?;
+        let parts = self
+            .take::<String>("parts")?
+            .map(|p| p.parse::<PartsRequest>())
+            .transpose()
+            .map_err(lib)?;
+        let from = self
+            .take::<String>("parts_from")?
+            .map(|f| f.parse::<PartsFrom>())
+            .transpose()
+            .map_err(lib)?;
+        // The mode as `coseg segment` reads it (the library's policy): parts by default,
+        // `regions` alone for equal-area regions.
+        let mut o2 = SegmentCollectionOptions::for_request(regions, parts, from);
+        o2.cosegment.area_fraction = self.take("area_fraction")?;
+        o2.cosegment.seed = self.take("seed")?;
+        if let Some(p) = o2.parts.as_mut() {
+            p.seed = o2.cosegment.seed;
+        }
         if let Some(v) = self.take("complete_limit")? {
-            graph.complete_limit = v;
+            o2.graph.complete_limit = v;
         }
         if let Some(v) = self.take("neighbours")? {
-            graph.neighbours = v;
+            o2.graph.neighbours = v;
         }
-        let base = d
+        let base = o2
             .refine
             .clone()
             .unwrap_or(SegmentCollectionOptions::DEFAULT_REFINE);
         let rounds = self.take("refine_rounds")?.unwrap_or(base.max_rounds);
         let time = self.take("smoothing_time")?.unwrap_or(base.smoothing_time);
-        let upper_bound: Option<usize> = self.take("regions")?;
-        let parts: Option<String> = self.take("parts")?;
-        let starts: Option<usize> = self.take("starts")?;
-        let sizes: Option<String> = self.take("refine_sizes")?;
-        let from: Option<String> = self.take("parts_from")?;
-        let snap_band: Option<f64> = self.take("snap_band")?;
-        let lib = |e: GraphError| super::lib_err(&e);
-        let mut o2 = d;
-        if let Some(v) = upper_bound {
-            cos.regions = v;
-        }
-        o2.graph = graph;
-        o2.cosegment = cos;
         o2.refine = (rounds > 0).then_some({
             let mut opts = RefineOptions::default();
             opts.max_rounds = rounds;
             opts.smoothing_time = time;
             opts
         });
-        if let Some(n) = starts {
+        if let Some(n) = self.take("starts")? {
             o2.starts = n;
         }
-        if let Some(r) = sizes {
+        if let Some(r) = self.take::<String>("refine_sizes")? {
             o2.refine_sizes = r.parse::<RefineSizes>().map_err(lib)?;
         }
-        if let Some(p) = parts {
-            o2.request_parts(p.parse::<PartsRequest>().map_err(lib)?, upper_bound);
-        }
-        if let Some(f) = from {
-            o2.set_parts_from(f.parse::<PartsFrom>().map_err(lib)?, upper_bound);
-        }
-        if let Some(b) = snap_band {
+        if let Some(b) = self.take::<f64>("snap_band")? {
             o2.set_snap_band(b).map_err(lib)?;
         }
         Ok(o2)
@@ -355,7 +351,20 @@ pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
     d.set_item("segment_smoothing_time", refine.smoothing_time)?;
     d.set_item("starts", s.starts)?;
     d.set_item("refine_sizes", "free")?;
-    d.set_item("parts_from", "adaptive")?;
+    d.set_item(
+        "parts_from",
+        match s.parts_from {
+            PartsFrom::Adaptive => "adaptive",
+            PartsFrom::Geometry { .. } => "geometry",
+        },
+    )?;
+    d.set_item(
+        "parts",
+        match s.parts.as_ref().and_then(|p| p.parts) {
+            Some(k) => k.to_string(),
+            None => "auto".to_string(),
+        },
+    )?;
     let a = coseg::parts::AdaptiveOptions::default();
     d.set_item("max_parts", a.max_parts)?;
     let r = StableRegionsOptions::default();

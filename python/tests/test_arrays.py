@@ -86,8 +86,11 @@ def test_defaults_are_the_library_defaults():
     d = coseg.DEFAULTS
     assert d["eigenpairs"] == 200 and d["bands"] == 20 and d["regions"] == 6
     sig = inspect.signature(coseg.segment).parameters
-    # None: 6 regions, or with parts= an upper bound of 8 parts (as the CLI's --regions).
+    # None: parts (12 equal-area leaves grouped, their number chosen), as the bare CLI; alone,
+    # that many equal-area regions; with parts_from="adaptive", an upper bound of 8 parts.
     assert sig["regions"].default is None and d["max_parts"] == 8
+    assert d["parts_from"] == "geometry" and d["parts"] == "auto"
+    assert sig["parts_from"].default is None and sig["families"].default is None
     assert sig["eigenpairs"].default == d["eigenpairs"]
     assert sig["starts"].default == d["starts"] == 1 and sig["refine_sizes"].default == "free"
     assert sig["normals"].default == d["normals"] == 0

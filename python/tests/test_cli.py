@@ -116,8 +116,8 @@ def test_parts_starts_and_normals_match_the_cli(coseg_bin, chairs, tmp_path):
     fam = ["--features", "spectral,extrinsic", "--up", "y", "--directions", "8", "--normals", "4"]
     kw = dict(families="spectral,extrinsic", up="y", directions=8, normals=4, **SMALL)
     runs = [
-        (["--regions", "5", "--parts", "3", "--refine-sizes", "keep:0.3"],
-         dict(regions=5, parts=3, refine_sizes="keep:0.3")),
+        (["--regions", "5", "--parts", "3", "--parts-from", "adaptive", "--refine-sizes", "keep:0.3"],
+         dict(regions=5, parts=3, parts_from="adaptive", refine_sizes="keep:0.3")),
         (["--parts", "auto"], dict(parts="auto")),
         (["--regions", "3", "--starts", "2"], dict(regions=3, starts=2)),
         (["--regions", "6", "--parts", "3", "--parts-from", "geometry"],
@@ -165,9 +165,8 @@ def test_bad_parts_options_raise(chairs):
         (dict(refine_sizes="keep:-1"), "expected"),
         (dict(refine_sizes="tight"), "expected"),
         (dict(parts="auto", starts=3), "starts = 3"),  # several starts: equal-area mode only
-        (dict(parts="auto", parts_from="geometry"), "number of parts"),
         (dict(parts=2, parts_from="size"), "expected"),
-        (dict(parts=2, snap_band=0.1), "parts from geometry"),  # the band is geometry's
+        (dict(parts=2, parts_from="adaptive", snap_band=0.1), "parts from geometry"),  # the band is geometry's
         (dict(parts=2, parts_from="geometry", snap_band=-1.0), "finite value"),
     ]
     for bad, message in cases:
@@ -177,3 +176,19 @@ def test_bad_parts_options_raise(chairs):
             assert message in str(e), (bad, str(e))
         else:
             raise AssertionError(f"{bad} accepted")
+
+
+def test_bare_segment_matches_the_bare_cli(coseg_bin, chairs, tmp_path):
+    """coseg.segment(shapes) with no mode or family options is the bare `coseg segment`: parts,
+    their number and the feature families chosen from the data, each choice with its reason."""
+    cli_out, py_out = tmp_path / "cli", tmp_path / "py"
+    subprocess.run(
+        [coseg_bin, "segment", str(chairs), "-o", str(cli_out), *cli_flags(), "--no-pictures"],
+        check=True,
+        capture_output=True,
+    )
+    r = coseg.segment(chairs, out=py_out, **SMALL)
+    assert_same_outputs(cli_out, py_out)
+    s = r["summary"]
+    assert s["features"]["chosen"] in ("intrinsic", "intrinsic_extrinsic") and s["features"]["reason"]
+    assert s["part_count"]["count"] == len(s["regions"]) and s["part_count"]["reason"]

@@ -26,9 +26,11 @@ pub struct PipelineArgs {
     #[arg(long)]
     area_bands: bool,
     /// Feature families, comma-separated: spectral, extrinsic, sdf, user:DIR (DIR holds
-    /// <mesh stem>.npy or .csv per shape). See docs/FEATURES.md.
-    #[arg(long, default_value = "spectral")]
-    features: String,
+    /// <mesh stem>.npy or .csv per shape). See docs/FEATURES.md. Default: `coseg segment`
+    /// chooses spectral or spectral,extrinsic (in the collection frame it aligns) from the data
+    /// (docs/PARTS.md); the other commands use spectral.
+    #[arg(long)]
+    features: Option<String>,
     /// Frame of the extrinsic family: the collection's up axis (x, y, z, -x, …) when it is
     /// already aligned, or pca.
     #[arg(long, default_value = "y")]
@@ -53,6 +55,11 @@ pub struct PipelineArgs {
 }
 
 impl PipelineArgs {
+    /// Whether `--features` was given (otherwise `coseg segment` chooses the families).
+    pub fn features_given(&self) -> bool {
+        self.features.is_some()
+    }
+
     /// The library options these flags select (library defaults for everything else).
     pub fn options(&self) -> anyhow::Result<ShapePipelineOptions> {
         let mut opts = ShapePipelineOptions::default();
@@ -66,7 +73,7 @@ impl PipelineArgs {
             opts.bands.weighting = BandWeighting::Area;
         }
         opts.set_families(
-            &self.features,
+            self.features.as_deref().unwrap_or("spectral"),
             &self.up,
             self.directions,
             self.normals,

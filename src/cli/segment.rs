@@ -3,9 +3,7 @@
 use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::cache::CacheOutcome;
-use coseg::graph::{
-    CosegmentOptions, GraphError, GraphOptions, LoadedCollection, RefineSizes, load_collection,
-};
+use coseg::graph::{GraphError, GraphOptions, LoadedCollection, RefineSizes, load_collection};
 use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
 use coseg::parts::{
     PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentedCollection, segment_collection,
@@ -31,21 +29,21 @@ pub struct SegmentArgs {
     /// Per-shape cache folder (default: `<OUT>/.cache`).
     #[arg(long)]
     cache: Option<PathBuf>,
-    /// Regions per shape, the last being the leftovers (default 6); with `--parts`, the upper
-    /// bound on the number of parts (default 8); with `--parts-from geometry`, the number of
-    /// equal-area regions grouped into parts (default 12).
+    /// Alone: the paper's equal-area stable regions instead of parts, this many per shape, the
+    /// last being the leftovers. With `--parts`: the number of equal-area regions grouped into
+    /// parts (default 12); with `--parts-from adaptive`, the upper bound on the number of parts
+    /// (default 8).
     #[arg(long)]
     regions: Option<usize>,
-    /// Parts of their own size (Algorithm 3 across the collection, see docs/PARTS.md): `auto`
-    /// = as many as are stable and consistent, `N` = cut the tree of parts at N. summary.json
-    /// then records the tree and the mirror pairs (left/right copies). Without it,
-    /// `--regions` equal-area regions.
+    /// How many parts (default `auto`): `auto` = the number the part tree's cut criterion
+    /// chooses (docs/PARTS.md), `N` = cut the tree of parts at N. summary.json records the
+    /// tree, the chosen count and why, and the mirror pairs (left/right copies).
     #[arg(long, value_parser = parse_parts)]
     parts: Option<PartsRequest>,
-    /// With `--parts N`, where the finest parts come from: `adaptive` (default; tuples of their
-    /// own size, grouped by what the affinity transports) or `geometry` (`--regions`
-    /// equal-area regions, default 12, grouped first where they touch or are left/right copies,
-    /// have one thickness and meet over convex surface; docs/PARTS.md).
+    /// Where the parts come from: `geometry` (default; `--regions` equal-area regions, 12,
+    /// grouped first where they touch or are left/right copies, have one thickness and meet
+    /// over convex surface) or `adaptive` (tuples of their own size, grouped by what the
+    /// affinity transports); docs/PARTS.md.
     #[arg(long, value_parser = parse_parts_from)]
     parts_from: Option<PartsFrom>,
     /// With `--parts-from geometry`: how far each part boundary may move onto a concave
@@ -153,6 +151,14 @@ pub fn run(args: SegmentArgs) -> Result<ExitCode> {
     for w in &result.warnings {
         super::warn(w);
     }
+    if !super::quiet() {
+        if let Some(f) = &result.features {
+            println!("{}", f.reason);
+        }
+        if let Some(c) = &result.part_count {
+            println!("{}", c.reason);
+        }
+    }
     let seg = &result.segmentation;
     let t_write = Instant::now();
     let files: Vec<String> = loaded
@@ -226,7 +232,7 @@ fn collection_options(
     loaded: &LoadedCollection,
     cache: &Path,
 ) -> Result<SegmentCollectionOptions> {
-    let mut o2 = SegmentCollectionOptions::default();
+    let mut o2 = SegmentCollectionOptions::for_request(args.regions, args.parts, args.parts_from);
     o2.graph = {
         let mut opts = GraphOptions::default();
         opts.complete_limit = args.complete_limit;
@@ -234,8 +240,7 @@ fn collection_options(
         opts
     };
     o2.cosegment = {
-        let mut opts = CosegmentOptions::default();
-        opts.regions = args.regions.unwrap_or(CosegmentOptions::default().regions);
+        let mut opts = o2.cosegment;
         opts.area_fraction = args.area_fraction;
         opts.seed = args.seed;
         opts
@@ -246,16 +251,15 @@ fn collection_options(
         opts.smoothing_time = args.smoothing_time;
         opts
     });
-    o2.feature_weights = pipeline.feature_weights(loaded.nodes[0].bands.features);
     o2.starts = args.starts;
     o2.refine_sizes = args.refine_sizes.unwrap_or_default();
-    o2.up = pipeline.up_direction();
-    o2.mirror_columns = pipeline.mirror_invariant_columns(loaded.nodes[0].bands.features);
-    if let Some(p) = args.parts {
-        o2.request_parts(p, args.regions);
-    }
-    if let Some(from) = args.parts_from {
-        o2.set_parts_from(from, args.regions);
+    o2.set_pipeline(
+        pipeline,
+        args.pipeline.features_given(),
+        loaded.nodes[0].bands.features,
+    );
+    if let Some(p) = o2.parts.as_mut() {
+        p.seed = args.seed;
     }
     if let Some(band) = args.snap_band {
         o2.set_snap_band(band)?;
@@ -316,9 +320,13 @@ fn report(
     );
     let times = &result.times;
     println!(
-        "time: read {:.2} s, per-shape data {:.2} s ({hits} cached), graph {:.2} s, co-segmentation {:.2} s{}, refinement {:.2} s{}, write {:.2} s, total {:.2} s",
+        "time: read {:.2} s, per-shape data {:.2} s ({hits} cached), {}graph {:.2} s, co-segmentation {:.2} s{}, refinement {:.2} s{}, write {:.2} s, total {:.2} s",
         loaded.read_time.as_secs_f64(),
         loaded.shape_time.as_secs_f64(),
+        match times.features {
+            Some(t) => format!("feature choice {:.2} s, ", t.as_secs_f64()),
+            None => String::new(),
+        },
         times.graph.as_secs_f64(),
         times.cosegment.as_secs_f64(),
         match times.part_cues {

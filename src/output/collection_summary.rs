@@ -102,6 +102,14 @@ pub struct CollectionSummary {
     /// confidence); absent with one start.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub starts: Option<StartsReport>,
+    /// The feature families chosen from the data and why (absent when `--features` was
+    /// given).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub features: Option<crate::parts::FeatureChoice>,
+    /// The number of parts chosen from the part tree and why (absent with `--parts N` or
+    /// equal-area regions).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub part_count: Option<crate::parts::PartCount>,
 }
 
 /// Which of several co-segmentation starts was kept ([`SegmentCollectionOptions::starts`]).
@@ -124,7 +132,7 @@ impl CollectionSummary {
     /// let t = equal_count_bands(&[0.0, 1.0, 2.0, 3.0], 1, 4, 4).unwrap();
     /// let nodes: Vec<ShapeNode> =
     ///     (0..2).map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &[1.0; 4]).unwrap()).collect();
-    /// let mut opts = SegmentCollectionOptions::default();
+    /// let mut opts = SegmentCollectionOptions::equal_areas(6);
     /// opts.refine = None;
     /// let out = segment_collection(nodes, &[], &opts).unwrap();
     /// let files = vec!["s0.obj".to_string(), "s1.obj".to_string()];
@@ -195,6 +203,8 @@ impl CollectionSummary {
                 chosen: result.start,
                 scores: result.start_scores.clone(),
             }),
+            features: result.features.clone(),
+            part_count: result.part_count.clone(),
         }
     }
 }

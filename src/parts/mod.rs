@@ -20,6 +20,9 @@
 //! Errors are the collection stage's [`GraphError`](crate::graph::GraphError).
 
 mod adaptive_cosegment;
+mod aligned_extrinsic_bands;
+mod choose_features;
+mod choose_part_count;
 mod geometric_part_tree;
 mod mirror_pairs;
 mod part_cues;
@@ -32,6 +35,9 @@ pub use adaptive_cosegment::{
     AdaptiveCosegmentation, AdaptiveOptions, AutoTuple, PartMerge, PartTree, Sizing, StopReason,
     adaptive_cosegment, adaptive_update,
 };
+pub use aligned_extrinsic_bands::aligned_extrinsic_bands;
+pub use choose_features::{ChooseFeaturesOptions, FeatureChoice, FeatureSet};
+pub use choose_part_count::{PartCount, choose_part_count};
 pub use geometric_part_tree::{
     geometric_part_tree, geometric_part_tree_linked, geometric_part_tree_with_cues,
 };
@@ -39,8 +45,8 @@ pub use mirror_pairs::{Likeness, MirrorPair, MirrorPlane, mirror_pairs, mirror_p
 pub use part_cues::{PartCues, PartCuesResult, load_or_compute_part_cues};
 pub use parts_report::PartsReport;
 pub use segment_collection::{
-    PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentTimes, SegmentedCollection,
-    segment_collection, start_score,
+    FeatureSelection, PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentTimes,
+    SegmentedCollection, segment_collection, start_score,
 };
 pub use snap_part_boundaries::snap_part_boundaries;
 pub use split_disconnected_leaves::{SplitLeaves, split_disconnected_leaves};

@@ -4,6 +4,8 @@
 use super::adaptive_cosegment::{
     AdaptiveCosegmentation, AdaptiveOptions, StopReason, adaptive_cosegment,
 };
+use super::choose_features::{ChooseFeaturesOptions, FeatureChoice, choose_features};
+use super::choose_part_count::{PartCount, choose_part_count};
 use super::geometric_part_tree::geometric_part_tree_linked;
 use super::mirror_pairs::{Likeness, mirror_pairs};
 use super::part_cues::collection_cues;
@@ -86,6 +88,33 @@ pub struct SegmentCollectionOptions {
     /// change the result.
     #[serde(skip)]
     pub cue_cache: Option<PathBuf>,
+    /// Which feature families the collection is co-segmented with (default
+    /// [`FeatureSelection::Chosen`]: chosen from the data by [`super::choose_features`] when the
+    /// nodes hold the intrinsic family alone). Not serialised: `summary.json` records the
+    /// choice itself ([`SegmentedCollection::features`]).
+    #[serde(skip)]
+    pub features: FeatureSelection,
+}
+
+/// Whether [`segment_collection`] chooses the feature families (`coseg segment` without
+/// `--features`) or takes the nodes' columns as they are (`--features F`).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub enum FeatureSelection {
+    /// The nodes' columns as given, weighted by [`SegmentCollectionOptions::feature_weights`].
+    Given,
+    /// The intrinsic family alone or with the extrinsic family in the collection frame,
+    /// whichever co-segments the collection more consistently ([`super::choose_features`]).
+    /// Applies when the nodes hold one family (no [`SegmentCollectionOptions::feature_weights`],
+    /// no [`SegmentCollectionOptions::up`]) and one mesh per node is given; otherwise the
+    /// columns are taken as given.
+    Chosen(ChooseFeaturesOptions),
+}
+
+impl Default for FeatureSelection {
+    fn default() -> Self {
+        Self::Chosen(ChooseFeaturesOptions::default())
+    }
 }
 
 /// Where `--parts N` takes its finest parts from, and how it groups them
@@ -277,6 +306,86 @@ impl SegmentCollectionOptions {
 }
 
 impl SegmentCollectionOptions {
+    /// Takes the feature families from the per-shape `pipeline` the nodes were computed with
+    /// (`columns` columns per node): when the families were `given` (`--features F`), the
+    /// nodes' columns as they are ([`FeatureSelection::Given`]) with the pipeline's family
+    /// weights, up axis and mirror-invariant columns; otherwise the families are chosen from
+    /// the data ([`FeatureSelection::Chosen`]), the extrinsic columns cut into bands as
+    /// `pipeline` cuts its own.
+    ///
+    /// ```
+    /// use coseg::parts::{FeatureSelection, SegmentCollectionOptions};
+    /// use coseg::pipeline::ShapePipelineOptions;
+    /// let mut o = SegmentCollectionOptions::default();
+    /// o.set_pipeline(&ShapePipelineOptions::default(), true, 300);
+    /// assert_eq!(o.features, FeatureSelection::Given);
+    /// ```
+    pub fn set_pipeline(
+        &mut self,
+        pipeline: &crate::pipeline::ShapePipelineOptions,
+        given: bool,
+        columns: usize,
+    ) {
+        if given {
+            self.features = FeatureSelection::Given;
+            self.feature_weights = pipeline.feature_weights(columns);
+            self.up = pipeline.up_direction();
+            self.mirror_columns = pipeline.mirror_invariant_columns(columns);
+        } else {
+            let mut c = match &self.features {
+                FeatureSelection::Chosen(c) => c.clone(),
+                FeatureSelection::Given => ChooseFeaturesOptions::default(),
+            };
+            c.weighting = pipeline.bands.weighting;
+            self.features = FeatureSelection::Chosen(c);
+        }
+    }
+
+    /// The options `coseg segment`'s (and `coseg.segment`'s) mode flags select, everything else
+    /// at its default:
+    /// - nothing: the default, parts from geometry, their number chosen from the part tree;
+    /// - `regions` alone: [`Self::equal_areas`] (the paper's equal-area stable regions);
+    /// - `parts` and/or `parts_from`: parts ([`Self::request_parts`], default
+    ///   [`PartsRequest::Auto`]) from `parts_from` (default [`PartsFrom::Geometry`]);
+    ///   `regions` is then the number of equal-area leaves of parts from geometry, or the
+    ///   upper bound on the number of adaptive parts.
+    ///
+    /// ```
+    /// use coseg::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions};
+    /// assert_eq!(
+    ///     SegmentCollectionOptions::for_request(None, None, None),
+    ///     SegmentCollectionOptions::default()
+    /// );
+    /// let regions = SegmentCollectionOptions::for_request(Some(6), None, None);
+    /// assert_eq!((regions.parts.is_none(), regions.cosegment.regions), (true, 6));
+    /// let four = SegmentCollectionOptions::for_request(Some(16), Some(PartsRequest::Count(4)), None);
+    /// assert_eq!(four.parts.unwrap().parts, Some(4));
+    /// assert_eq!(four.parts_from, PartsFrom::Geometry { leaves: 16, band: 0.1 });
+    /// let adaptive = "adaptive".parse().unwrap();
+    /// let a = SegmentCollectionOptions::for_request(Some(5), None, Some(adaptive));
+    /// assert_eq!((a.parts.unwrap().max_parts, a.parts_from), (5, PartsFrom::Adaptive));
+    /// ```
+    pub fn for_request(
+        regions: Option<usize>,
+        parts: Option<PartsRequest>,
+        parts_from: Option<PartsFrom>,
+    ) -> Self {
+        if let (Some(r), None, None) = (regions, parts, parts_from) {
+            return Self::equal_areas(r);
+        }
+        let mut o = Self::default();
+        let from = parts_from.unwrap_or(o.parts_from);
+        // `regions` bounds the number of adaptive parts; parts from geometry take it as their
+        // leaves.
+        let bound = match from {
+            PartsFrom::Adaptive => regions,
+            PartsFrom::Geometry { .. } => None,
+        };
+        o.request_parts(parts.unwrap_or(PartsRequest::Auto), bound);
+        o.set_parts_from(from, regions);
+        o
+    }
+
     /// Sets [`Self::parts_from`]; `regions` (`coseg segment --regions`), when given, is the
     /// number of leaves of [`PartsFrom::Geometry`].
     ///
@@ -304,8 +413,8 @@ impl SegmentCollectionOptions {
     ///
     /// ```
     /// use coseg::parts::{PartsFrom, SegmentCollectionOptions};
-    /// let mut o = SegmentCollectionOptions::default();
-    /// assert!(o.set_snap_band(0.1).is_err()); // adaptive parts have no band
+    /// let mut o = SegmentCollectionOptions::equal_areas(6);
+    /// assert!(o.set_snap_band(0.1).is_err()); // equal-area regions have no band
     /// o.set_parts_from("geometry".parse().unwrap(), None);
     /// o.set_snap_band(0.0).unwrap(); // the regions' boundaries as they are
     /// assert_eq!(o.parts_from, PartsFrom::Geometry { leaves: 12, band: 0.0 });
@@ -325,11 +434,43 @@ impl SegmentCollectionOptions {
     }
 }
 
+/// The default is `coseg segment FOLDER`: parts from geometry ([`PartsFrom::Geometry`]: 12
+/// refined equal-area regions grouped by the geometric part tree), as many as the tree's cut
+/// criterion chooses ([`super::choose_part_count`]), on the feature families chosen from the
+/// data ([`FeatureSelection::Chosen`]). [`SegmentCollectionOptions::equal_areas`] gives the
+/// paper's equal-area regions (`coseg segment --regions N`).
 impl Default for SegmentCollectionOptions {
     fn default() -> Self {
         Self {
+            parts: Some(AdaptiveOptions::default()),
+            parts_from: PartsFrom::Geometry {
+                leaves: PartsFrom::GEOMETRY_LEAVES,
+                band: PartsFrom::GEOMETRY_BAND,
+            },
+            ..Self::equal_areas(CosegmentOptions::default().regions)
+        }
+    }
+}
+
+impl SegmentCollectionOptions {
+    /// `regions` equal-area regions ([`cosegment`] then the refinement; the paper's fixed
+    /// cutoff, `coseg segment --regions N`), the feature families chosen from the data as by
+    /// default.
+    ///
+    /// ```
+    /// use coseg::parts::SegmentCollectionOptions;
+    /// let o = SegmentCollectionOptions::equal_areas(6);
+    /// assert_eq!((o.parts.is_none(), o.cosegment.regions), (true, 6));
+    /// assert!(SegmentCollectionOptions::default().parts.is_some());
+    /// ```
+    pub fn equal_areas(regions: usize) -> Self {
+        let cosegment = CosegmentOptions {
+            regions,
+            ..CosegmentOptions::default()
+        };
+        Self {
             graph: GraphOptions::default(),
-            cosegment: CosegmentOptions::default(),
+            cosegment,
             refine: Some(Self::DEFAULT_REFINE),
             feature_weights: None,
             parts: None,
@@ -340,6 +481,7 @@ impl Default for SegmentCollectionOptions {
             mirror_columns: Vec::new(),
             parts_from: PartsFrom::Adaptive,
             cue_cache: None,
+            features: FeatureSelection::default(),
         }
     }
 }
@@ -358,6 +500,9 @@ pub struct SegmentTimes {
     /// Reading or computing the [`super::PartCues`] (`None`: not needed, only
     /// [`PartsFrom::Geometry`] reads them).
     pub part_cues: Option<Duration>,
+    /// Choosing the feature families (alignment, extrinsic columns, the two probe
+    /// co-segmentations and the graph; `None` when the columns were given).
+    pub features: Option<Duration>,
 }
 
 /// The result of [`segment_collection`].
@@ -380,8 +525,15 @@ pub struct SegmentedCollection {
     /// [`SegmentCollectionOptions::mirror_columns`], likewise.
     pub mirror_columns: Vec<usize>,
     /// Warnings for the user: part-cue cache entries that were not trusted or not written
-    /// (the run's results do not depend on them).
+    /// (the run's results do not depend on them), an alignment or extrinsic family that could
+    /// not be computed (the intrinsic family was used).
     pub warnings: Vec<String>,
+    /// The feature families chosen from the data, and why ([`FeatureSelection::Chosen`]);
+    /// `None` when the columns were taken as given.
+    pub features: Option<FeatureChoice>,
+    /// The number of parts chosen from the part tree, and why (parts from geometry without a
+    /// number of parts); `None` otherwise.
+    pub part_count: Option<PartCount>,
 }
 
 impl SegmentedCollection {
@@ -435,12 +587,19 @@ fn mirror_links(
 /// [`refine_cosegmentation`](crate::graph::refine_cosegmentation), heat-smoothing on each shape's `meshes[i]` (same order as
 /// `nodes`; only needed when refining with a positive smoothing time).
 ///
+/// With the default options (`coseg segment FOLDER`) the feature families are first chosen
+/// from the data ([`FeatureSelection::Chosen`]: the nodes' intrinsic columns alone or with the
+/// extrinsic family in the collection frame), and the result is parts: twelve refined
+/// equal-area regions grouped by the geometric part tree, cut where the tree's merge costs
+/// jump most ([`super::choose_part_count`]). [`SegmentedCollection::features`] and
+/// [`SegmentedCollection::part_count`] say what was chosen and why.
+///
 /// Deterministic: the same nodes and options give the same segmentation, bit for bit.
 ///
 /// ```
 /// use coseg::bands::equal_count_bands;
 /// use coseg::graph::{ShapeNode};
-/// use coseg::parts::{segment_collection, SegmentCollectionOptions};
+/// use coseg::parts::{segment_collection, FeatureSelection, SegmentCollectionOptions};
 /// use coseg::mesh::TriMesh;
 /// // Three identical 4-vertex shapes (a tetrahedron) with one feature in 4 bands.
 /// let mesh = TriMesh::new(
@@ -451,8 +610,9 @@ fn mirror_links(
 /// let nodes: Vec<ShapeNode> = (0..3)
 ///     .map(|i| ShapeNode::new(format!("s{i}"), t.clone(), &mesh.vertex_areas()).unwrap())
 ///     .collect();
-/// let mut opts = SegmentCollectionOptions::default();
-/// opts.cosegment.regions = 2;
+/// // Two equal-area regions over the nodes' columns as given.
+/// let mut opts = SegmentCollectionOptions::equal_areas(2);
+/// opts.features = FeatureSelection::Given;
 /// let out = segment_collection(nodes, &[mesh.clone(), mesh.clone(), mesh], &opts).unwrap();
 /// assert_eq!(out.segmentation.labels(0), out.segmentation.labels(2));
 /// ```
@@ -478,12 +638,46 @@ pub fn segment_collection(
         ));
     }
     let mut times = SegmentTimes::default();
+    let mut warnings = Vec::new();
     let t = Instant::now();
-    let mut graph = ShapeGraph::build(nodes, &options.graph)?;
-    if options.feature_weights.is_some() {
-        graph.set_feature_weights(options.feature_weights.clone())?;
-    }
-    times.graph = t.elapsed();
+    let choose = match &options.features {
+        FeatureSelection::Chosen(c)
+            if options.feature_weights.is_none()
+                && options.up.is_none()
+                && !meshes.is_empty()
+                && meshes.len() == nodes.len() =>
+        {
+            Some(c)
+        }
+        _ => None,
+    };
+    let (graph, chosen_options, features) = match choose {
+        Some(c) => {
+            let chosen = choose_features(
+                nodes,
+                meshes,
+                &options.graph,
+                &options.cosegment,
+                c,
+                &mut warnings,
+            )?;
+            let mut o = options.clone();
+            o.feature_weights = chosen.feature_weights;
+            o.up = chosen.up;
+            o.mirror_columns = chosen.mirror_columns;
+            times.features = Some(t.elapsed());
+            (chosen.graph, Some(o), Some(chosen.choice))
+        }
+        None => {
+            let mut graph = ShapeGraph::build(nodes, &options.graph)?;
+            if options.feature_weights.is_some() {
+                graph.set_feature_weights(options.feature_weights.clone())?;
+            }
+            times.graph = t.elapsed();
+            (graph, None, None)
+        }
+    };
+    let options = chosen_options.as_ref().unwrap_or(options);
     if options.starts == 0 {
         return Err(GraphError::BadOption("starts must be at least 1".into()));
     }
@@ -501,18 +695,17 @@ pub fn segment_collection(
             ));
         }
         (Some(p), PartsFrom::Geometry { leaves, band }) => {
-            let Some(parts) = p.parts else {
-                return Err(GraphError::BadOption(
-                    "parts from geometry need a number of parts (--parts N, not auto)".into(),
-                ));
-            };
-            if leaves < parts {
+            if let Some(parts) = p.parts
+                && leaves < parts
+            {
                 return Err(GraphError::BadOption(format!(
                     "parts from geometry: {leaves} regions cannot make {parts} parts"
                 )));
             }
             check_band(band)?;
-            Some((leaves, parts, band))
+            // Without a number of parts, the tree's cut criterion chooses one, at most the
+            // upper bound (`--regions` with `--parts auto`).
+            Some((leaves, p.parts.ok_or(p.max_parts), band))
         }
         _ => None,
     };
@@ -533,7 +726,6 @@ pub fn segment_collection(
         _ => None,
     };
     times.smoothers = t.elapsed();
-    let mut warnings = Vec::new();
     let cues = match geometry {
         Some(_) => {
             let t = Instant::now();
@@ -550,6 +742,7 @@ pub fn segment_collection(
         None => None,
     };
     let mut best: Option<(f64, usize, Cosegmentation, Option<AdaptiveCosegmentation>)> = None;
+    let mut part_count = None;
     let mut start_scores = Vec::with_capacity(options.starts);
     for start in 0..options.starts {
         let t = Instant::now();
@@ -618,6 +811,15 @@ pub fn segment_collection(
                 .as_deref()
                 .expect("computed above with parts from geometry");
             let tree = geometric_part_tree_linked(meshes, cues, &segmentation, &links, &siblings)?;
+            let parts = match parts {
+                Ok(k) => k,
+                Err(max_parts) => {
+                    let c = choose_part_count(&tree, max_parts);
+                    let k = c.count;
+                    part_count = Some(c);
+                    k
+                }
+            };
             let a = AdaptiveCosegmentation {
                 leaves: segmentation,
                 auto: Vec::new(),
@@ -647,5 +849,7 @@ pub fn segment_collection(
         up: options.up,
         mirror_columns: options.mirror_columns.clone(),
         warnings,
+        features,
+        part_count,
     })
 }

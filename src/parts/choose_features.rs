@@ -1,0 +1,269 @@
+//! [`choose_features`]: which feature families a collection is co-segmented with, chosen by
+//! the consistency each reaches on it (`coseg segment` without `--features`).
+//!
+//! Two kinds of collections want different features. Posed bodies (a cat sitting and
+//! standing) are near-isometric: the intrinsic (spectral) family describes a point the same
+//! way in every pose, while heights and normal directions change with the pose. Man-made
+//! collections (chairs, goblets) are rigid but not isometric (a stool and an armchair have
+//! different intrinsic geometry): heights and normal directions in one collection frame tell
+//! a seat from a back, the spectra do not. Which kind a collection is shows in how well each
+//! family's co-segmentation agrees with itself around the shape graph: the equal-area
+//! co-segmentation into a dozen regions is computed with each candidate (the intrinsic family
+//! alone; the intrinsic and the extrinsic families, the latter in the collection frame of
+//! [`crate::align::align_collection`]), and the candidate whose regions are carried between
+//! shapes most consistently (the higher mean tuple confidence, [`super::start_score`]: the
+//! area IoU of each region with its neighbours' regions carried onto it) wins. A collection
+//! that does not align (posed bodies, shapes the alignment got wrong) gives the extrinsic
+//! columns regions that do not carry over, and the intrinsic family wins; nothing depends on
+//! how the files are oriented beyond what the alignment recovers.
+
+use super::aligned_extrinsic_bands::{aligned_extrinsic_bands, concat_tables};
+use super::segment_collection::start_score;
+use crate::align::{AlignOptions, FrameCase, align_collection};
+use crate::bands::BandWeighting;
+use crate::features::{ExtrinsicOptions, FamilyWeights, FeatureFamilies};
+use crate::graph::{CosegmentOptions, GraphError, GraphOptions, ShapeGraph, ShapeNode, cosegment};
+use crate::mesh::TriMesh;
+use serde::Serialize;
+
+/// Options of [`choose_features`] (the default: `coseg segment` without `--features`).
+#[derive(Debug, Clone, PartialEq)]
+#[non_exhaustive]
+pub struct ChooseFeaturesOptions {
+    /// The collection alignment that gives the extrinsic family its frame (default
+    /// [`AlignOptions::default`]).
+    pub align: AlignOptions,
+    /// The extrinsic family's columns (default: [`ExtrinsicOptions::default`]'s 100 height
+    /// directions and two distances, with [`ChooseFeaturesOptions::DEFAULT_NORMALS`] normal
+    /// columns); its `alignment` is ignored (the frame is the collection's).
+    pub extrinsic: ExtrinsicOptions,
+    /// How the extrinsic columns are cut into bands (default [`BandWeighting::Count`], as the
+    /// per-shape pipeline's default; the band count is the nodes').
+    pub weighting: BandWeighting,
+    /// Equal-area regions of the probe co-segmentation each candidate is scored on (default
+    /// 12, [`super::PartsFrom::GEOMETRY_LEAVES`]: the finest parts of the default mode).
+    pub probe_regions: usize,
+}
+
+impl ChooseFeaturesOptions {
+    /// Normal columns `|n · u|` of the chosen extrinsic family: 16 directions, the count the
+    /// aligned figures of docs/FEATURES.md and docs/PARTS.md were measured with (they tell a
+    /// seat from a back at the same height).
+    pub const DEFAULT_NORMALS: usize = 16;
+}
+
+impl Default for ChooseFeaturesOptions {
+    fn default() -> Self {
+        let extrinsic = ExtrinsicOptions {
+            normal_directions: Self::DEFAULT_NORMALS,
+            ..ExtrinsicOptions::default()
+        };
+        Self {
+            align: AlignOptions::default(),
+            extrinsic,
+            weighting: BandWeighting::Count,
+            probe_regions: super::PartsFrom::GEOMETRY_LEAVES,
+        }
+    }
+}
+
+/// The feature families a collection was co-segmented with.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FeatureSet {
+    /// The intrinsic (spectral) family alone.
+    Intrinsic,
+    /// The intrinsic and the extrinsic families (heights, distances and normal columns in the
+    /// collection frame), one equal share each for the spectral columns, the heights and
+    /// distances, and the normal columns.
+    IntrinsicExtrinsic,
+}
+
+impl FeatureSet {
+    /// The name printed and recorded: `spectral` or `spectral,extrinsic`.
+    pub fn name(self) -> &'static str {
+        match self {
+            FeatureSet::Intrinsic => "spectral",
+            FeatureSet::IntrinsicExtrinsic => "spectral,extrinsic",
+        }
+    }
+}
+
+/// What [`choose_features`] decided, and why (`summary.json`'s `features`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FeatureChoice {
+    /// The families used.
+    pub chosen: FeatureSet,
+    /// The probe's mean region confidence with the intrinsic family alone.
+    pub intrinsic_score: f64,
+    /// The same with both families, the better of the two up axes; `None` when the extrinsic
+    /// family could not be computed (the warning says why).
+    pub aligned_score: Option<f64>,
+    /// The probe's score with both families for each up axis tried (as the alignment found
+    /// it, then reversed).
+    pub aligned_scores: Vec<f64>,
+    /// How the collection frame was found (`None`: the alignment failed).
+    pub frame: Option<FrameCase>,
+    /// The frame's up axis in file coordinates when the files were already aligned.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub up: Option<[f64; 3]>,
+    /// One sentence for the user: the choice and the reason.
+    pub reason: String,
+}
+
+/// The chosen nodes and what the collection stage needs of them.
+#[derive(Debug, Clone)]
+pub(crate) struct ChosenFeatures {
+    /// The shape graph over the chosen columns, feature weights set.
+    pub graph: ShapeGraph,
+    /// The per-column weights (`None`: the intrinsic family alone).
+    pub feature_weights: Option<Vec<f64>>,
+    /// The up axis in file coordinates (already aligned files only).
+    pub up: Option<[f64; 3]>,
+    /// Columns a mirror image leaves unchanged (the spectral ones).
+    pub mirror_columns: Vec<usize>,
+    /// The report.
+    pub choice: FeatureChoice,
+}
+
+/// A candidate with the extrinsic family: its probe score, graph, weights and up axis.
+type Candidate = (f64, ShapeGraph, Option<Vec<f64>>, Option<[f64; 3]>);
+
+/// Chooses the feature families of a collection (module docs) and builds its shape graph.
+///
+/// Inputs: `nodes` (#shapes, the intrinsic family's band tables, as the default per-shape
+/// pipeline gives them), `meshes` (graph order, one per node), `graph` (the shape graph's
+/// options), `cosegment` (the co-segmentation's options; its region count is replaced by
+/// [`ChooseFeaturesOptions::probe_regions`]), `options`.
+///
+/// Output: the chosen graph, weights and the [`FeatureChoice`]; `warnings` gets a line when
+/// the alignment or the extrinsic columns fail (the intrinsic family is then used).
+///
+/// Cost: one collection alignment (≈ 0.1 s of CPU per shape), the extrinsic columns (a pass
+/// over the vertices per column), and two raw equal-area co-segmentations.
+///
+/// Errors: those of [`ShapeGraph::build`] and [`cosegment`].
+///
+/// Known issues: the alignment is rigid and recovers the frame of strongly different shapes
+/// (a stool and an armchair moved at random) only in part (docs/ALIGN.md); the shapes it
+/// misplaces weaken the extrinsic candidate, which then loses to the intrinsic one rather
+/// than mislead.
+pub(crate) fn choose_features(
+    nodes: Vec<ShapeNode>,
+    meshes: &[TriMesh],
+    graph: &GraphOptions,
+    cosegment_options: &CosegmentOptions,
+    options: &ChooseFeaturesOptions,
+    warnings: &mut Vec<String>,
+) -> Result<ChosenFeatures, GraphError> {
+    let spectral = nodes.first().map_or(0, |n| n.bands.features);
+    let mut probe = *cosegment_options;
+    probe.regions = options.probe_regions;
+    let mirror_columns: Vec<usize> = (0..spectral).collect();
+    // Candidates with the extrinsic family: the collection frame with its up axis as the
+    // alignment's rule names it, and reversed (the rule reads which side the mass leans to,
+    // which a collection need not show; the two give different co-segmentations).
+    let mut best: Option<Candidate> = None;
+    let mut aligned_scores = Vec::new();
+    let mut frame = None;
+    match align_collection(meshes, &options.align) {
+        Err(e) => warnings.push(format!(
+            "the collection could not be aligned ({e}): the intrinsic family alone is used"
+        )),
+        Ok(alignment) => {
+            frame = Some(alignment.case);
+            let mut band_options = crate::bands::BandOptions::default();
+            band_options.bands = nodes.first().map_or(band_options.bands, |n| n.bands.bands);
+            band_options.weighting = options.weighting;
+            for reverse in [false, true] {
+                let (tables, up) = match aligned_extrinsic_bands(
+                    meshes,
+                    &alignment,
+                    &options.extrinsic,
+                    &band_options,
+                    reverse,
+                ) {
+                    Ok(t) => t,
+                    Err(e) => {
+                        warnings.push(format!("{e}: the intrinsic family alone is used"));
+                        break;
+                    }
+                };
+                let both: Vec<ShapeNode> = nodes
+                    .iter()
+                    .zip(&tables)
+                    .map(|(n, t)| ShapeNode {
+                        bands: concat_tables(&n.bands, t),
+                        ..n.clone()
+                    })
+                    .collect();
+                let families = FeatureFamilies {
+                    extrinsic: Some(options.extrinsic.clone()),
+                    weights: FamilyWeights::default(),
+                    ..FeatureFamilies::default()
+                };
+                let ext = tables.first().map_or(0, |t| t.features);
+                let weights = families.feature_weights(spectral, [ext, 0, 0]);
+                let mut g = ShapeGraph::build(both, graph)?;
+                g.set_feature_weights(weights.clone())?;
+                let score = start_score(&cosegment(&g, &probe)?);
+                aligned_scores.push(score);
+                if best.as_ref().is_none_or(|b| score > b.0) {
+                    best = Some((score, g, weights, up));
+                }
+            }
+        }
+    }
+    let intrinsic = ShapeGraph::build(nodes, graph)?;
+    let intrinsic_score = start_score(&cosegment(&intrinsic, &probe)?);
+    let aligned_score = best.as_ref().map(|b| b.0);
+    let case = match frame {
+        Some(FrameCase::AlreadyAligned) => "the files' frames agree",
+        Some(FrameCase::Synchronised) => "aligned by registration",
+        Some(FrameCase::Single) | None => "one shape",
+    };
+    let scores = aligned_scores
+        .iter()
+        .map(|s| format!("{s:.3}"))
+        .collect::<Vec<_>>()
+        .join(" / ");
+    Ok(match best {
+        Some((score, g, weights, up)) if score > intrinsic_score => ChosenFeatures {
+            graph: g,
+            feature_weights: weights,
+            up,
+            mirror_columns,
+            choice: FeatureChoice {
+                chosen: FeatureSet::IntrinsicExtrinsic,
+                intrinsic_score,
+                aligned_score,
+                aligned_scores,
+                frame,
+                up,
+                reason: format!(
+                    "features spectral,extrinsic: the collection is rigid-like ({case}); its regions carry over more consistently with the extrinsic family in the collection frame (mean confidence {scores}, up axis as found / reversed) than with the spectral family alone ({intrinsic_score:.3})"
+                ),
+            },
+        },
+        _ => ChosenFeatures {
+            graph: intrinsic,
+            feature_weights: None,
+            up: None,
+            mirror_columns,
+            choice: FeatureChoice {
+                chosen: FeatureSet::Intrinsic,
+                intrinsic_score,
+                aligned_score,
+                aligned_scores,
+                frame,
+                up: None,
+                reason: match aligned_score {
+                    Some(_) => format!(
+                        "features spectral: the collection is near-isometric or does not align rigidly ({case}); its regions carry over more consistently with the spectral family alone (mean confidence {intrinsic_score:.3}) than with the extrinsic family added ({scores}, up axis as found / reversed)"
+                    ),
+                    None => "features spectral: the extrinsic family could not be computed (see the warning)".to_string(),
+                },
+            },
+        },
+    })
+}

@@ -1,0 +1,67 @@
+//! Tests of the feature families chosen from the data (src/parts/choose_features.rs), through
+//! `parts::segment_collection` with its default `FeatureSelection::Chosen`.
+
+mod common;
+
+use coseg::graph::ShapeNode;
+use coseg::mesh::{TriMesh, read_mesh};
+use coseg::parts::{FeatureSelection, FeatureSet, SegmentCollectionOptions, segment_collection};
+use coseg::pipeline::compute_shape_data;
+
+/// Three shipped goblets with the small test pipeline's spectral columns.
+fn goblets() -> (Vec<TriMesh>, Vec<ShapeNode>) {
+    let o = common::features::small_pipeline(20, 6);
+    let dir = common::generate::collections_dir().join("goblets");
+    let meshes: Vec<TriMesh> = (0..3)
+        .map(|i| read_mesh(dir.join(format!("goblets_{i:02}.obj"))).unwrap())
+        .collect();
+    let nodes = meshes
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let d = compute_shape_data(m, &o).unwrap();
+            ShapeNode::new(format!("g{i}"), d.bands, &d.descriptors.vertex_areas).unwrap()
+        })
+        .collect();
+    (meshes, nodes)
+}
+
+/// By default the families are chosen and the choice is reported with both candidates'
+/// scores (the extrinsic one for each up axis tried), the winner being the higher; the run is
+/// deterministic; with the columns given, nothing is chosen or reported.
+#[test]
+fn the_feature_families_are_chosen_by_the_consistency_each_reaches() {
+    let (meshes, nodes) = goblets();
+    let spectral = nodes[0].bands.features;
+    let mut o = SegmentCollectionOptions::equal_areas(4);
+    o.refine = None;
+    let out = segment_collection(nodes.clone(), &meshes, &o).unwrap();
+    let f = out.features.as_ref().expect("the choice is reported");
+    assert_eq!(f.aligned_scores.len(), 2, "{f:?}");
+    let aligned = f.aligned_score.unwrap();
+    assert!((0.0..=1.0).contains(&f.intrinsic_score) && (0.0..=1.0).contains(&aligned));
+    match f.chosen {
+        FeatureSet::IntrinsicExtrinsic => {
+            assert!(aligned > f.intrinsic_score);
+            assert!(
+                f.reason.starts_with("features spectral,extrinsic"),
+                "{}",
+                f.reason
+            );
+            // The extrinsic columns were added to the graph's nodes.
+            assert!(out.graph.node(0).bands.features > spectral);
+        }
+        FeatureSet::Intrinsic => {
+            assert!(aligned <= f.intrinsic_score);
+            assert!(f.reason.starts_with("features spectral:"), "{}", f.reason);
+            assert_eq!(out.graph.node(0).bands.features, spectral);
+        }
+    }
+    let again = segment_collection(nodes.clone(), &meshes, &o).unwrap();
+    assert_eq!(again.segmentation, out.segmentation);
+    assert_eq!(again.features, out.features);
+    o.features = FeatureSelection::Given;
+    let given = segment_collection(nodes, &meshes, &o).unwrap();
+    assert!(given.features.is_none());
+    assert_eq!(given.graph.node(0).bands.features, spectral);
+}
