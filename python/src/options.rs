@@ -7,7 +7,7 @@ use coseg::features::{
     ExtrinsicOptions, FamilyWeights, FeatureError, parse_alignment, parse_families,
     parse_family_weights,
 };
-use coseg::graph::{CosegmentOptions, GraphError, GraphOptions, RefineSizes};
+use coseg::graph::{GraphError, GraphOptions, RefineSizes};
 use coseg::maps::{MapGuidedOptions, MapOverrides, MapPreset, MapStep, ZoomOutOptions};
 use coseg::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions};
 use coseg::pipeline::ShapePipelineOptions;

@@ -31,9 +31,10 @@ use rayon::prelude::*;
 /// - [`FrameCase::Synchronised`]: each shape is moved by its transform into the collection
 ///   frame, whose up axis is `+y`;
 /// - [`FrameCase::AlreadyAligned`] and [`FrameCase::Single`]: the files' frame, with up the
-///   signed file axis closest to the alignment's up direction — files whose frames already
-///   agree are almost always written with an axis up, and the third-moment rule of the
-///   alignment can tilt away from it on shapes of uneven mass (docs/ALIGN.md).
+///   positive file axis closest to the alignment's up direction (reversed with `reverse`) —
+///   files whose frames already agree are almost always written with a positive axis up, and
+///   the third-moment rule of the alignment can tilt away from that axis or reverse it on
+///   shapes of uneven mass (docs/ALIGN.md).
 ///
 /// Errors: a message naming the shape index when a shape's columns cannot be computed (the
 /// caller falls back to the intrinsic family with a warning).
@@ -60,7 +61,12 @@ pub fn aligned_extrinsic_bands(
             positive: true,
         }
     } else {
-        nearest_axis(alignment.up)
+        // Files whose frames agree are written with a positive axis up (the convention of
+        // `--up`); the alignment's up only says which axis.
+        Axis {
+            positive: true,
+            ..nearest_axis(alignment.up)
+        }
     };
     axis.positive ^= reverse;
     let mut options = extrinsic.clone();

@@ -18,7 +18,7 @@
 //! how the files are oriented beyond what the alignment recovers.
 
 use super::aligned_extrinsic_bands::{aligned_extrinsic_bands, concat_tables};
-use super::segment_collection::start_score;
+use super::start_score::start_score;
 use crate::align::{AlignOptions, FrameCase, align_collection};
 use crate::bands::BandWeighting;
 use crate::features::{ExtrinsicOptions, FamilyWeights, FeatureFamilies};
@@ -41,7 +41,7 @@ pub struct ChooseFeaturesOptions {
     /// per-shape pipeline's default; the band count is the nodes').
     pub weighting: BandWeighting,
     /// Equal-area regions of the probe co-segmentation each candidate is scored on (default
-    /// 12, [`super::PartsFrom::GEOMETRY_LEAVES`]: the finest parts of the default mode).
+    /// [`ChooseFeaturesOptions::DEFAULT_PROBE_REGIONS`]).
     pub probe_regions: usize,
 }
 
@@ -50,6 +50,11 @@ impl ChooseFeaturesOptions {
     /// aligned figures of docs/FEATURES.md and docs/PARTS.md were measured with (they tell a
     /// seat from a back at the same height).
     pub const DEFAULT_NORMALS: usize = 16;
+
+    /// Regions of the probe: 12, the finest parts of the default mode (as many as the
+    /// equal-area leaves of parts from geometry, `PartsFrom::GEOMETRY_LEAVES`; a test keeps
+    /// the two equal), so each candidate is scored on the regions the parts are grouped from.
+    pub const DEFAULT_PROBE_REGIONS: usize = 12;
 }
 
 impl Default for ChooseFeaturesOptions {
@@ -62,7 +67,7 @@ impl Default for ChooseFeaturesOptions {
             align: AlignOptions::default(),
             extrinsic,
             weighting: BandWeighting::Count,
-            probe_regions: super::PartsFrom::GEOMETRY_LEAVES,
+            probe_regions: Self::DEFAULT_PROBE_REGIONS,
         }
     }
 }
@@ -96,11 +101,12 @@ pub struct FeatureChoice {
     pub chosen: FeatureSet,
     /// The probe's mean region confidence with the intrinsic family alone.
     pub intrinsic_score: f64,
-    /// The same with both families, the better of the two up axes; `None` when the extrinsic
+    /// The same with both families, the best of the up axes tried; `None` when the extrinsic
     /// family could not be computed (the warning says why).
     pub aligned_score: Option<f64>,
-    /// The probe's score with both families for each up axis tried (as the alignment found
-    /// it, then reversed).
+    /// The probe's score with both families for each up axis tried: the positive file axis
+    /// when the files' frames agree; the synchronised frame's up as the alignment found it,
+    /// then reversed, when the shapes were moved.
     pub aligned_scores: Vec<f64>,
     /// How the collection frame was found (`None`: the alignment failed).
     pub frame: Option<FrameCase>,
@@ -160,9 +166,11 @@ pub(crate) fn choose_features(
     let mut probe = *cosegment_options;
     probe.regions = options.probe_regions;
     let mirror_columns: Vec<usize> = (0..spectral).collect();
-    // Candidates with the extrinsic family: the collection frame with its up axis as the
-    // alignment's rule names it, and reversed (the rule reads which side the mass leans to,
-    // which a collection need not show; the two give different co-segmentations).
+    // Candidates with the extrinsic family. Files whose frames already agree: the positive file
+    // axis nearest the alignment's up (files are written with a positive axis up, the
+    // convention `--up` follows; the alignment's sign rule reads which side the mass leans to,
+    // which chairs, for one, do not show). Shapes moved into a synchronised frame: its up axis
+    // as the rule names it, and reversed, the probe deciding (nothing else tells the sign).
     let mut best: Option<Candidate> = None;
     let mut aligned_scores = Vec::new();
     let mut frame = None;
@@ -175,7 +183,11 @@ pub(crate) fn choose_features(
             let mut band_options = crate::bands::BandOptions::default();
             band_options.bands = nodes.first().map_or(band_options.bands, |n| n.bands.bands);
             band_options.weighting = options.weighting;
-            for reverse in [false, true] {
+            let signs: &[bool] = match alignment.case {
+                FrameCase::Synchronised => &[false, true],
+                FrameCase::AlreadyAligned | FrameCase::Single => &[false],
+            };
+            for &reverse in signs {
                 let (tables, up) = match aligned_extrinsic_bands(
                     meshes,
                     &alignment,
@@ -222,6 +234,11 @@ pub(crate) fn choose_features(
         Some(FrameCase::Synchronised) => "aligned by registration",
         Some(FrameCase::Single) | None => "one shape",
     };
+    let signs = if aligned_scores.len() > 1 {
+        ", up axis as found / reversed"
+    } else {
+        ""
+    };
     let scores = aligned_scores
         .iter()
         .map(|s| format!("{s:.3}"))
@@ -241,7 +258,7 @@ pub(crate) fn choose_features(
                 frame,
                 up,
                 reason: format!(
-                    "features spectral,extrinsic: the collection is rigid-like ({case}); its regions carry over more consistently with the extrinsic family in the collection frame (mean confidence {scores}, up axis as found / reversed) than with the spectral family alone ({intrinsic_score:.3})"
+                    "features spectral,extrinsic: the collection is rigid-like ({case}); its regions carry over more consistently with the extrinsic family in the collection frame (mean confidence {scores}{signs}) than with the spectral family alone ({intrinsic_score:.3})"
                 ),
             },
         },
@@ -259,7 +276,7 @@ pub(crate) fn choose_features(
                 up: None,
                 reason: match aligned_score {
                     Some(_) => format!(
-                        "features spectral: the collection is near-isometric or does not align rigidly ({case}); its regions carry over more consistently with the spectral family alone (mean confidence {intrinsic_score:.3}) than with the extrinsic family added ({scores}, up axis as found / reversed)"
+                        "features spectral: the collection is near-isometric or does not align rigidly ({case}); its regions carry over more consistently with the spectral family alone (mean confidence {intrinsic_score:.3}) than with the extrinsic family added ({scores}{signs})"
                     ),
                     None => "features spectral: the extrinsic family could not be computed (see the warning)".to_string(),
                 },

@@ -30,6 +30,7 @@ mod parts_report;
 mod segment_collection;
 mod snap_part_boundaries;
 mod split_disconnected_leaves;
+mod start_score;
 
 pub use adaptive_cosegment::{
     AdaptiveCosegmentation, AdaptiveOptions, AutoTuple, PartMerge, PartTree, Sizing, StopReason,
@@ -46,7 +47,8 @@ pub use part_cues::{PartCues, PartCuesResult, load_or_compute_part_cues};
 pub use parts_report::PartsReport;
 pub use segment_collection::{
     FeatureSelection, PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentTimes,
-    SegmentedCollection, segment_collection, start_score,
+    SegmentedCollection, segment_collection,
 };
 pub use snap_part_boundaries::snap_part_boundaries;
 pub use split_disconnected_leaves::{SplitLeaves, split_disconnected_leaves};
+pub use start_score::start_score;

@@ -12,6 +12,7 @@ use super::part_cues::collection_cues;
 use super::parts_report::PartsReport;
 use super::snap_part_boundaries::{check_band, snap_part_boundaries};
 use super::split_disconnected_leaves::split_disconnected_leaves;
+use super::start_score::start_score;
 use crate::graph::{
     CosegmentOptions, Cosegmentation, GraphError, GraphOptions, RefineSizes, ShapeGraph, ShapeNode,
     cosegment, refine_cosegmentation_sized,
@@ -549,19 +550,6 @@ impl SegmentedCollection {
             PartsReport::new(a, &self.segmentation, meshes, self.up, Some(likeness))
         })
     }
-}
-
-/// The score by which [`segment_collection`] chooses among starts: the mean confidence of the
-/// segmentation's tuples (leftovers included), in `[0, 1]`; `0` for a segmentation of fewer
-/// than two tuples. One tuple covering every shape splits nothing and agrees with itself
-/// perfectly (confidence 1), so it would beat every real segmentation: with `--parts auto` a
-/// start whose extraction finds no stable tuple returned the whole shape as one part and won.
-pub fn start_score(segmentation: &Cosegmentation) -> f64 {
-    let t = &segmentation.tuples;
-    if t.len() < 2 {
-        return 0.0;
-    }
-    t.iter().map(|x| x.confidence).sum::<f64>() / t.len() as f64
 }
 
 /// The mirror pairs among `coseg`'s tuples as leaf pairs, under `options`' up direction and
