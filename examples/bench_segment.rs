@@ -43,7 +43,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--refine-rounds" => {
                 let rounds: usize = args.next().ok_or("--refine-rounds N")?.parse()?;
                 seg_opts.refine = (rounds > 0).then_some({
-                    let mut opts = SegmentCollectionOptions::DEFAULT_REFINE;
+                    let mut opts = SegmentCollectionOptions::default()
+                        .refine
+                        .unwrap_or_default();
                     opts.max_rounds = rounds;
                     opts
                 });

@@ -53,7 +53,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut alpha: Option<f64> = None;
     let mut graph_opts = GraphOptions::default();
     let mut files = Vec::new();
-    let mut refine = SegmentCollectionOptions::DEFAULT_REFINE;
+    let mut refine = SegmentCollectionOptions::default()
+        .refine
+        .unwrap_or_default();
     while let Some(a) = args.next() {
         match a.as_str() {
             "--cache" => cache = PathBuf::from(args.next().ok_or("--cache DIR")?),

@@ -258,7 +258,9 @@ fn main() -> Res<()> {
     let mut args = std::env::args().skip(1);
     let folder = PathBuf::from(args.next().ok_or("FOLDER")?);
     let mut cache = std::env::temp_dir().join("coseg-eval-cache");
-    let mut refine_rounds = SegmentCollectionOptions::DEFAULT_REFINE.max_rounds;
+    let mut refine_rounds = SegmentCollectionOptions::default()
+        .refine
+        .map_or(0, |r| r.max_rounds);
     let mut modes = Vec::new();
     let (mut features, mut up, mut starts) = ("spectral".to_string(), "y".to_string(), 1);
     let mut keep: Option<f64> = None;

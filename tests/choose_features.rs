@@ -74,12 +74,9 @@ fn the_feature_families_are_chosen_by_the_consistency_each_reaches() {
 /// The probe is scored on as many regions as the default parts are grouped from.
 #[test]
 fn the_probe_has_the_regions_of_the_default_parts() {
-    assert_eq!(
-        ChooseFeaturesOptions::default().probe_regions,
-        PartsFrom::GEOMETRY_LEAVES
-    );
-    assert_eq!(
-        ChooseFeaturesOptions::DEFAULT_PROBE_REGIONS,
-        PartsFrom::GEOMETRY_LEAVES
-    );
+    let leaves = match SegmentCollectionOptions::default().parts_from {
+        PartsFrom::Geometry { leaves, .. } => leaves,
+        PartsFrom::Adaptive => panic!("the default parts come from geometry"),
+    };
+    assert_eq!(ChooseFeaturesOptions::default().probe_regions, leaves);
 }

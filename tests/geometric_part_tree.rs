@@ -205,7 +205,7 @@ fn parts_from_geometry_cuts_the_tree_of_equal_area_regions() {
     none.features = FeatureSelection::Given;
     none.parts_from = PartsFrom::Geometry {
         leaves: 6,
-        band: PartsFrom::GEOMETRY_BAND,
+        band: 0.1,
     };
     assert!(matches!(
         segment_collection(nodes, &meshes, &none),

@@ -66,13 +66,15 @@ __all__ = [
 
 __version__ = "0.1.0"
 
-#: The library's default of every keyword option (``pair_*``/``segment_*`` where the two
-#: stages differ).
-DEFAULTS: Dict[str, Any] = dict(_coseg.defaults())
+#: The library's default of every keyword option, by command (``"segment"``, ``"pair"``,
+#: ``"propagate"``, ...) and keyword, the per-shape options under ``"pipeline"``
+#: (``coseg::jobs::defaults``; ``None``: unset, the library chooses).
+DEFAULTS: Dict[str, Dict[str, Any]] = _coseg.defaults()
 #: Version of the cache entry format (entries of another version are recomputed).
 FORMAT_VERSION: int = _coseg.FORMAT_VERSION
 
 _D = DEFAULTS
+_P = DEFAULTS["pipeline"]
 #: The spectral family's parts, selectable alone in ``families``.
 SPECTRAL = ("hks", "wks", "curv")
 #: The feature families (besides ``"user:DIR"``), as the CLI's ``--features``.
@@ -185,11 +187,11 @@ def _weights(family_weights: Any) -> str:
 
 
 def _pipeline(
-    families: Union[str, Sequence[str]] = _D["features"],
-    up: str = _D["up"],
-    directions: int = _D["directions"],
+    families: Union[str, Sequence[str]] = _P["features"],
+    up: str = _P["up"],
+    directions: int = _P["directions"],
     family_weights: Any = None,
-    normals: int = _D["normals"],
+    normals: int = _P["normals"],
     **counts: Any,
 ) -> Dict[str, Any]:
     """The native module's per-shape options from the public keywords: ``families`` becomes
@@ -233,7 +235,7 @@ def read_mesh(path: Union[str, os.PathLike]) -> Tuple[np.ndarray, np.ndarray]:
     return V, F
 
 
-def spectrum(V: Any, F: Any, k: int = _D["eigenpairs"]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def spectrum(V: Any, F: Any, k: int = _P["eigenpairs"]) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The ``k`` smallest Laplace-Beltrami eigenpairs of the mesh scaled to unit area:
     ``(eigenvalues (k,), eigenvectors (n, k), vertex_areas (n,))`` with eigenvectors
     orthonormal under the lumped mass ``vertex_areas``. Default ``k``: 200."""
@@ -245,14 +247,14 @@ def features(
     V: Any,
     F: Any,
     *,
-    families: Union[str, Sequence[str]] = _D["features"],
-    eigenpairs: int = _D["eigenpairs"],
-    hks: int = _D["hks"],
-    wks: int = _D["wks"],
-    curvature: int = _D["curvature"],
-    up: str = _D["up"],
-    directions: int = _D["directions"],
-    normals: int = _D["normals"],
+    families: Union[str, Sequence[str]] = _P["features"],
+    eigenpairs: int = _P["eigenpairs"],
+    hks: int = _P["hks"],
+    wks: int = _P["wks"],
+    curvature: int = _P["curvature"],
+    up: str = _P["up"],
+    directions: int = _P["directions"],
+    normals: int = _P["normals"],
 ) -> Tuple[List[str], np.ndarray]:
     """Per-vertex descriptors: ``(names, matrix)`` with ``matrix`` ``n x N`` float64 and
     ``names[j]`` naming column ``j`` (``hks_000``, ..., ``wks_...``, ``curv_...``, then
@@ -270,16 +272,16 @@ def band_table(
     V: Any,
     F: Any,
     *,
-    families: Union[str, Sequence[str]] = _D["features"],
-    eigenpairs: int = _D["eigenpairs"],
-    hks: int = _D["hks"],
-    wks: int = _D["wks"],
-    curvature: int = _D["curvature"],
-    bands: int = _D["bands"],
-    area_bands: bool = _D["area_bands"],
-    up: str = _D["up"],
-    directions: int = _D["directions"],
-    normals: int = _D["normals"],
+    families: Union[str, Sequence[str]] = _P["features"],
+    eigenpairs: int = _P["eigenpairs"],
+    hks: int = _P["hks"],
+    wks: int = _P["wks"],
+    curvature: int = _P["curvature"],
+    bands: int = _P["bands"],
+    area_bands: bool = _P["area_bands"],
+    up: str = _P["up"],
+    directions: int = _P["directions"],
+    normals: int = _P["normals"],
 ) -> np.ndarray:
     """The band table: ``n x N`` uint8, entry ``(v, j)`` the band (``0..bands``) of vertex
     ``v`` in feature ``j`` (columns as :func:`features`, same ``families``, ``up``,
@@ -335,33 +337,33 @@ def pair(
     names: Optional[Tuple[str, str]] = None,
     cache_dir: Optional[Union[str, os.PathLike]] = None,
     out: Optional[Union[str, os.PathLike]] = None,
-    algorithm: str = _D["algorithm"],
-    pairs: int = _D["pairs"],
-    alpha: float = _D["alpha"],
-    alpha_of_remaining: bool = _D["alpha_of_remaining"],
-    delta_t: float = _D["delta_t"],
-    t_max: float = _D["t_max"],
-    linear_t: bool = _D["linear_t"],
-    init: str = _D["init"],
-    seed: int = _D["pair_seed"],
-    max_iterations: int = _D["max_iterations"],
-    refine_rounds: int = _D["pair_refine_rounds"],
-    smoothing_time: float = _D["pair_smoothing_time"],
+    algorithm: str = _D["pair"]["algorithm"],
+    pairs: int = _D["pair"]["pairs"],
+    alpha: float = _D["pair"]["alpha"],
+    alpha_of_remaining: bool = _D["pair"]["alpha_of_remaining"],
+    delta_t: float = _D["pair"]["delta_t"],
+    t_max: float = _D["pair"]["t_max"],
+    linear_t: bool = _D["pair"]["linear_t"],
+    init: str = _D["pair"]["init"],
+    seed: int = _D["pair"]["seed"],
+    max_iterations: int = _D["pair"]["max_iterations"],
+    refine_rounds: int = _D["pair"]["refine_rounds"],
+    smoothing_time: float = _D["pair"]["smoothing_time"],
     map_weight: Optional[float] = None,
-    map_preset: str = _D["map_preset"],
-    map_size: int = _D["map_size"],
-    map_smoothing_time: float = _D["map_smoothing_time"],
-    eigenpairs: int = _D["eigenpairs"],
-    hks: int = _D["hks"],
-    wks: int = _D["wks"],
-    curvature: int = _D["curvature"],
-    bands: int = _D["bands"],
-    area_bands: bool = _D["area_bands"],
-    families: Union[str, Sequence[str]] = _D["features"],
-    up: str = _D["up"],
-    directions: int = _D["directions"],
+    map_preset: str = _D["pair"]["map_preset"],
+    map_size: Optional[int] = _D["pair"]["map_size"],
+    map_smoothing_time: Optional[float] = _D["pair"]["map_smoothing_time"],
+    eigenpairs: int = _P["eigenpairs"],
+    hks: int = _P["hks"],
+    wks: int = _P["wks"],
+    curvature: int = _P["curvature"],
+    bands: int = _P["bands"],
+    area_bands: bool = _P["area_bands"],
+    families: Union[str, Sequence[str]] = _P["features"],
+    up: str = _P["up"],
+    directions: int = _P["directions"],
     family_weights: Any = None,
-    normals: int = _D["normals"],
+    normals: int = _P["normals"],
 ) -> Dict[str, Any]:
     """Stable region correspondences between two shapes (``coseg pair``).
 
@@ -424,27 +426,27 @@ def segment(
     out: Optional[Union[str, os.PathLike]] = None,
     regions: Optional[int] = None,
     parts: Optional[Union[str, int]] = None,
-    starts: int = _D["starts"],
-    refine_sizes: str = _D["refine_sizes"],
+    starts: int = _D["segment"]["starts"],
+    refine_sizes: str = _D["segment"]["refine_sizes"],
     parts_from: Optional[str] = None,
     snap_band: Optional[float] = None,
-    area_fraction: Optional[float] = _D["area_fraction"],
-    seed: Optional[int] = _D["segment_seed"],
-    complete_limit: int = _D["complete_limit"],
-    neighbours: int = _D["neighbours"],
-    refine_rounds: int = _D["segment_refine_rounds"],
-    smoothing_time: float = _D["segment_smoothing_time"],
-    eigenpairs: int = _D["eigenpairs"],
-    hks: int = _D["hks"],
-    wks: int = _D["wks"],
-    curvature: int = _D["curvature"],
-    bands: int = _D["bands"],
-    area_bands: bool = _D["area_bands"],
+    area_fraction: Optional[float] = _D["segment"]["area_fraction"],
+    seed: Optional[int] = _D["segment"]["seed"],
+    complete_limit: int = _D["segment"]["complete_limit"],
+    neighbours: int = _D["segment"]["neighbours"],
+    refine_rounds: int = _D["segment"]["refine_rounds"],
+    smoothing_time: float = _D["segment"]["smoothing_time"],
+    eigenpairs: int = _P["eigenpairs"],
+    hks: int = _P["hks"],
+    wks: int = _P["wks"],
+    curvature: int = _P["curvature"],
+    bands: int = _P["bands"],
+    area_bands: bool = _P["area_bands"],
     families: Optional[Union[str, Sequence[str]]] = None,
-    up: str = _D["up"],
-    directions: int = _D["directions"],
+    up: str = _P["up"],
+    directions: int = _P["directions"],
     family_weights: Any = None,
-    normals: int = _D["normals"],
+    normals: int = _P["normals"],
 ) -> Dict[str, Any]:
     """Consistent co-segmentation of a collection (``coseg segment``).
 
@@ -505,7 +507,7 @@ def segment(
         cache_dir=_path(cache_dir),
         out=_path(out),
         **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands,
-                _D["features"] if families is None else families, up, directions, family_weights, normals),
+                _P["features"] if families is None else families, up, directions, family_weights, normals),
     )
     if families is None:
         # As `coseg segment` without --features: the library chooses the families.
@@ -543,27 +545,27 @@ def propagate(
     cache_dir: Optional[Union[str, os.PathLike]] = None,
     out: Optional[Union[str, os.PathLike]] = None,
     part_names: Any = None,
-    complete_limit: int = _D["complete_limit"],
-    neighbours: int = _D["neighbours"],
-    smoothing_time: float = _D["propagate_smoothing_time"],
-    max_sweeps: int = _D["max_sweeps"],
-    network_weight: float = _D["network_weight"],
-    similarity_power: float = _D["similarity_power"],
-    size_prior: float = _D["size_prior"],
-    area_weighted: bool = _D["area_weighted"],
+    complete_limit: int = _D["propagate"]["complete_limit"],
+    neighbours: int = _D["propagate"]["neighbours"],
+    smoothing_time: float = _D["propagate"]["smoothing_time"],
+    max_sweeps: int = _D["propagate"]["max_sweeps"],
+    network_weight: float = _D["propagate"]["network_weight"],
+    similarity_power: float = _D["propagate"]["similarity_power"],
+    size_prior: float = _D["propagate"]["size_prior"],
+    area_weighted: bool = _D["propagate"]["area_weighted"],
     map_step: bool = False,
-    map_agreement: float = _D["map_agreement"],
-    eigenpairs: int = _D["eigenpairs"],
-    hks: int = _D["hks"],
-    wks: int = _D["wks"],
-    curvature: int = _D["curvature"],
-    bands: int = _D["bands"],
-    area_bands: bool = _D["area_bands"],
-    families: Union[str, Sequence[str]] = _D["features"],
-    up: str = _D["up"],
-    directions: int = _D["directions"],
+    map_agreement: float = _D["propagate"]["map_agreement"],
+    eigenpairs: int = _P["eigenpairs"],
+    hks: int = _P["hks"],
+    wks: int = _P["wks"],
+    curvature: int = _P["curvature"],
+    bands: int = _P["bands"],
+    area_bands: bool = _P["area_bands"],
+    families: Union[str, Sequence[str]] = _P["features"],
+    up: str = _P["up"],
+    directions: int = _P["directions"],
     family_weights: Any = None,
-    normals: int = _D["normals"],
+    normals: int = _P["normals"],
 ) -> Dict[str, Any]:
     """Part labels from a few annotated shapes to a whole collection (``coseg propagate``).
 
@@ -684,10 +686,10 @@ def _pipeline_opts(options: Dict[str, Any]) -> Dict[str, Any]:
         raise TypeError(f"unknown per-shape option(s): {', '.join(sorted(unknown))}")
     o = dict(options)
     fam = dict(
-        families=o.pop("families", _D["features"]),
-        up=o.pop("up", _D["up"]),
-        directions=o.pop("directions", _D["directions"]),
-        normals=o.pop("normals", _D["normals"]),
+        families=o.pop("families", _P["features"]),
+        up=o.pop("up", _P["up"]),
+        directions=o.pop("directions", _P["directions"]),
+        normals=o.pop("normals", _P["normals"]),
         family_weights=o.pop("family_weights", None),
     )
     return _pipeline(**fam, **o)

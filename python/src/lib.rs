@@ -6,16 +6,14 @@
 mod options;
 
 use coseg::cache::CacheOutcome;
-use coseg::graph::{ShapeNode, load_collection};
 use coseg::jobs::{
-    CacheChoice, JobError, JobLabels, JobShape, PairJob, PropagateInput, PropagateJob, run_pair,
-    run_propagate,
+    CacheChoice, JobError, JobLabels, JobShape, PairJob, PropagateInput, PropagateJob,
+    SegmentInput, run_pair, run_propagate, run_segment,
 };
 use coseg::labels::PartNames;
 use coseg::mesh::{MeshFormat, TriMesh, read_mesh_with_report};
-use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions};
-use coseg::parts::{SegmentCollectionOptions, segment_collection};
-use coseg::pipeline::{ShapePipelineOptions, compute_shape_data, load_or_compute_bands};
+use coseg::output::SkippedInput;
+use coseg::pipeline::compute_shape_data;
 use coseg::shape_task;
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 use numpy::ndarray::Array2;
@@ -23,7 +21,6 @@ use numpy::{IntoPyArray, PyArray1, PyArray2, PyReadonlyArray2, PyUntypedArrayMet
 use options::Opts;
 use pyo3::prelude::*;
 use pyo3::types::{PyBytes, PyDict, PyList};
-use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// The package exception for a library error: `FileError` (an `OSError`) when an I/O error is
@@ -47,7 +44,6 @@ fn lib_err_in(e: &(dyn std::error::Error + 'static), context: Option<&str>) -> P
     };
     raise(if io { "FileError" } else { "InputError" }, message)
 }
-
 
 /// A `coseg.errors.<class>` exception with `message`.
 fn raise(class: &str, message: String) -> PyErr {
@@ -152,10 +148,11 @@ fn json<'py>(py: Python<'py>, value: &impl serde::Serialize) -> PyResult<Bound<'
     py.import("json")?.call_method1("loads", (text,))
 }
 
-/// Library defaults of every option the package exposes, by keyword.
+/// The library's default of every option, by command and keyword
+/// ([`coseg::jobs::defaults`]).
 #[pyfunction]
-fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    options::defaults(py)
+fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyAny>> {
+    json(py, &coseg::jobs::defaults())
 }
 
 /// Reads a mesh file (.obj, .off, .ply): `(V, F, warnings)`.
@@ -330,27 +327,6 @@ impl Shape {
             mesh: self.mesh,
         }
     }
-
-    /// The pipeline options for this shape: user features (`user:DIR`) resolved to its file,
-    /// `DIR/<stem>.npy` or `.csv`, by the stem of the file it was read from or, for arrays, by
-    /// its name (as the CLI resolves them per mesh file).
-    fn pipeline(&self, pipe: &ShapePipelineOptions) -> Result<ShapePipelineOptions, String> {
-        if pipe.families.user.is_none() {
-            return Ok(pipe.clone());
-        }
-        // A trailing dot: the whole name is the stem, even with dots in it.
-        let path = if self.from_file {
-            PathBuf::from(&self.file)
-        } else {
-            PathBuf::from(format!("{}.", self.name))
-        };
-        let mut p = pipe.clone();
-        p.families = pipe
-            .families
-            .for_shape(&path)
-            .map_err(|e| format!("{}: {e}", self.name))?;
-        Ok(p)
-    }
 }
 
 fn shapes_from(
@@ -426,97 +402,17 @@ fn pair<'py>(
     Ok(d)
 }
 
-/// What `segment` works on: the loaded shapes, where their data came from, and notes.
-struct Loaded {
-    names: Vec<String>,
-    files: Vec<String>,
-    meshes: Vec<TriMesh>,
-    nodes: Vec<ShapeNode>,
-    skipped: Vec<SkippedInput>,
-    warnings: Vec<String>,
-    /// Per shape: `"hit"`, `"miss"` or `"recomputed"` (cache), `"computed"` (no cache).
-    outcomes: Vec<&'static str>,
-}
-
-fn outcome_name(o: &CacheOutcome) -> &'static str {
+fn outcome_name(o: &Option<CacheOutcome>) -> &'static str {
     match o {
-        CacheOutcome::Hit => "hit",
-        CacheOutcome::Miss => "miss",
-        CacheOutcome::Recomputed { .. } => "recomputed",
+        Some(CacheOutcome::Hit) => "hit",
+        Some(CacheOutcome::Miss) => "miss",
+        Some(CacheOutcome::Recomputed { .. }) => "recomputed",
+        None => "computed",
     }
 }
 
-/// Shapes given as arrays: the per-shape stage on rayon's pool (through the cache if given).
-fn load_arrays(
-    shapes: Vec<Shape>,
-    pipe: &ShapePipelineOptions,
-    cache: Option<&Path>,
-) -> Result<Loaded, String> {
-    let results: Vec<_> = shapes
-        .par_iter()
-        .map(
-            |s| -> Result<(ShapeNode, Vec<String>, &'static str), String> {
-                let pipe = &s.pipeline(pipe)?;
-                let (bands, areas, warnings, how) = match cache {
-                    Some(dir) => {
-                        let r = load_or_compute_bands(&s.mesh, pipe, dir)
-                            .map_err(|e| format!("{}: {e}", s.name))?;
-                        (
-                            r.data.bands,
-                            r.data.vertex_areas,
-                            r.warnings,
-                            outcome_name(&r.outcome),
-                        )
-                    }
-                    None => {
-                        let d = compute_shape_data(&s.mesh, pipe)
-                            .map_err(|e| format!("{}: {e}", s.name))?;
-                        (d.bands, d.descriptors.vertex_areas, Vec::new(), "computed")
-                    }
-                };
-                let node = ShapeNode::new(s.name.clone(), bands, &areas)
-                    .map_err(|e| format!("{}: {e}", s.name))?;
-                Ok((node, warnings, how))
-            },
-        )
-        .collect();
-    let mut out = Loaded {
-        names: Vec::new(),
-        files: Vec::new(),
-        meshes: Vec::new(),
-        nodes: Vec::new(),
-        skipped: Vec::new(),
-        warnings: Vec::new(),
-        outcomes: Vec::new(),
-    };
-    for (s, r) in shapes.into_iter().zip(results) {
-        let (node, warnings, how) = r?;
-        out.warnings.extend(warnings);
-        out.outcomes.push(how);
-        out.names.push(s.name);
-        out.files.push(s.file);
-        out.meshes.push(s.mesh);
-        out.nodes.push(node);
-    }
-    Ok(out)
-}
-
-/// A folder, read exactly as `coseg segment FOLDER` reads it.
-fn load_folder(folder: &Path, pipe: &ShapePipelineOptions, cache: &Path) -> Result<Loaded, String> {
-    let c = load_collection(folder, pipe, cache, |_, _, _| {})
-        .map_err(|e| format!("reading {}: {e}", folder.display()))?;
-    Ok(Loaded {
-        names: c.nodes.iter().map(|n| n.name.clone()).collect(),
-        files: c.paths.iter().map(|p| p.display().to_string()).collect(),
-        meshes: c.meshes,
-        nodes: c.nodes,
-        skipped: c.skipped.iter().map(SkippedInput::from).collect(),
-        warnings: c.warnings,
-        outcomes: c.outcomes.iter().map(outcome_name).collect(),
-    })
-}
-
-/// Collection stage: `{"names", "labels", "summary", "skipped", "warnings", "written"}`.
+/// Collection stage: `{"names", "labels", "summary", "skipped", "warnings", "outcomes",
+/// "written"}`.
 #[pyfunction]
 #[pyo3(signature = (shapes, names=None, options=None, files=None))]
 fn segment<'py>(
@@ -526,84 +422,38 @@ fn segment<'py>(
     options: Option<Bound<'py, PyDict>>,
     files: Option<Vec<Option<String>>>,
 ) -> PyResult<Bound<'py, PyDict>> {
-    // As `coseg segment`: without `features` the library chooses the families from the data.
-    let features_given = match &options {
-        Some(d) => d.get_item("features")?.is_some_and(|v| !v.is_none()),
-        None => false,
-    };
     let mut o = Opts::new(options);
-    let pipe = o.pipeline()?;
+    let mut job = o.segment()?;
     let cache: Option<PathBuf> = o.take("cache_dir")?;
-    let out_dir: Option<PathBuf> = o.take("out")?;
-    let mut seg_opts: SegmentCollectionOptions = o.segment()?;
+    job.output = o.take("out")?;
     o.finish()?;
-    let loaded = if let Ok(list) = shapes.cast::<PyList>() {
-        let list = shapes_from(list, names, files)?;
-        if list.len() < 2 {
-            return Err(input_err(format!(
-                "co-segmentation needs at least 2 readable shapes, got {}",
-                list.len()
-            )));
-        }
-        seg_opts.cue_cache = cache.clone();
-        py.detach(|| load_arrays(list, &pipe, cache.as_deref()))
+    // Python returns arrays; pictures are `coseg.render`'s.
+    job.pictures = false;
+    let input = if let Ok(list) = shapes.cast::<PyList>() {
+        job.cache = cache.map_or(CacheChoice::Off, CacheChoice::Dir);
+        let shapes = shapes_from(list, names, files)?;
+        SegmentInput::Shapes(shapes.into_iter().map(Shape::into_job_shape).collect())
     } else {
-        let folder: PathBuf = shapes.extract()?;
-        let cache = cache.clone().unwrap_or_else(|| match &out_dir {
-            Some(o) => o.join(".cache"),
-            None => folder.join(".cache"),
-        });
-        seg_opts.cue_cache = Some(cache.clone());
-        py.detach(|| load_folder(&folder, &pipe, &cache))
-    }
-    .map_err(input_err)?;
-    if loaded.nodes.len() < 2 {
-        return Err(input_err(format!(
-            "co-segmentation needs at least 2 readable shapes, got {}",
-            loaded.nodes.len()
-        )));
-    }
-    let Loaded {
-        names,
-        files,
-        meshes,
-        nodes,
-        skipped,
-        warnings,
-        outcomes,
-    } = loaded;
-    // As `coseg segment`: the given families, or the families chosen from the data.
-    seg_opts.set_pipeline(&pipe, features_given, nodes[0].bands.features);
-    let result = py
-        .detach(|| segment_collection(nodes, &meshes, &seg_opts))
-        .or_raise()?;
-    let mut summary = CollectionSummary::new(&result, &files, &seg_opts, skipped.clone());
-    summary.parts = result.parts_report(&meshes);
-    let mut warnings = warnings;
-    warnings.extend(result.warnings.iter().cloned());
-    warnings.extend(summary.parts.as_ref().and_then(|p| p.warning()));
-    let seg = &result.segmentation;
-    let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
-    let written = match &out_dir {
-        Some(dir) => {
-            let list = ShapeRegions::collection(&seg.names, &meshes, &labels);
-            py.detach(|| write_regions(dir, &list, &summary))
-                .or_raise()?
-        }
-        None => Vec::new(),
+        job.cache = cache.map_or(CacheChoice::Auto, CacheChoice::Dir);
+        SegmentInput::Folder(shapes.extract()?)
     };
+    let outcome = py
+        .detach(|| run_segment(input, &job))
+        .map_err(|e| lib_err(&e))?;
     let d = PyDict::new(py);
-    d.set_item("names", names)?;
-    let arrays: Vec<Bound<PyArray1<i32>>> = labels
-        .into_iter()
-        .map(|l| PyArray1::from_vec(py, l))
+    d.set_item("names", outcome.result.segmentation.names.clone())?;
+    let arrays: Vec<Bound<PyArray1<i32>>> = outcome
+        .labels
+        .iter()
+        .map(|l| PyArray1::from_slice(py, l))
         .collect();
     d.set_item("labels", arrays)?;
-    d.set_item("summary", json(py, &summary)?)?;
-    d.set_item("skipped", json(py, &skipped)?)?;
-    d.set_item("warnings", warnings)?;
+    d.set_item("summary", json(py, &outcome.summary)?)?;
+    d.set_item("skipped", json(py, &outcome.skipped)?)?;
+    d.set_item("warnings", outcome.warnings.clone())?;
+    let outcomes: Vec<&str> = outcome.cache_outcomes.iter().map(outcome_name).collect();
     d.set_item("outcomes", outcomes)?;
-    d.set_item("written", written)?;
+    d.set_item("written", outcome.written.clone())?;
     Ok(d)
 }
 
@@ -682,7 +532,7 @@ fn propagate<'py>(
     let outcomes: Vec<&str> = outcome
         .cache_outcomes
         .iter()
-        .map(|o| o.as_ref().map_or("computed", outcome_name))
+        .map(outcome_name)
         .collect();
     let p = &result.propagation;
     let n = result.graph.node_count();

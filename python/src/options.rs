@@ -3,14 +3,12 @@
 //! unknown keys rejected so that a typo never passes silently.
 
 use coseg::bands::BandWeighting;
-use coseg::features::{
-    ExtrinsicOptions, FamilyWeights, FeatureError, parse_alignment, parse_families,
-    parse_family_weights,
-};
+use coseg::features::FeatureError;
 use coseg::graph::{GraphError, GraphOptions, RefineSizes};
-use coseg::maps::{MapGuidedOptions, MapOverrides, MapPreset, MapStep, ZoomOutOptions};
-use coseg::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions};
-use coseg::pipeline::ShapePipelineOptions;
+use coseg::jobs::SegmentJob;
+use coseg::maps::{MapOverrides, MapPreset, MapStep};
+use coseg::parts::{PartsFrom, PartsRequest};
+use coseg::pipeline::{FamilyFlags, ShapePipelineOptions};
 use coseg::propagate::{MapStepOptions, PropagateOptions};
 use coseg::stable::{
     Algorithm, AreaReference, Init, RefineOptions, SegmentPairOptions, StableRegionsOptions,
@@ -18,11 +16,6 @@ use coseg::stable::{
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
-
-/// The CLI's `--features` default.
-const DEFAULT_FEATURES: &str = "spectral";
-/// The CLI's `--up` default.
-const DEFAULT_UP: &str = "y";
 
 /// The options dict, consumed key by key.
 pub struct Opts<'py>(Option<Bound<'py, PyDict>>);
@@ -65,30 +58,26 @@ impl<'py> Opts<'py> {
     /// `eigenpairs`, `hks`, `wks`, `curvature`, `bands`, `area_bands`, and the feature
     /// families: `features` (`spectral,extrinsic,sdf,user:DIR`), `up`, `directions`,
     /// `normals`, `family_weights` (`NAME=W,...`), as the CLI's `--features`, `--up`,
-    /// `--directions`, `--normals`, `--family-weights` (same parsers, same defaults).
+    /// `--directions`, `--normals`, `--family-weights` (same parsers, the library's
+    /// [`FamilyFlags`] defaults).
     pub fn pipeline(&mut self) -> PyResult<ShapePipelineOptions> {
         let mut p = ShapePipelineOptions::default();
-        let features: Option<String> = self.take("features")?;
-        let up: Option<String> = self.take("up")?;
-        let directions: Option<usize> = self.take("directions")?;
-        let normals: Option<usize> = self.take("normals")?;
-        let weights: Option<String> = self.take("family_weights")?;
-        let lib = |e: FeatureError| super::lib_err(&e);
-        let alignment = parse_alignment(up.as_deref().unwrap_or(DEFAULT_UP)).map_err(lib)?;
-        let (spectral, mut families) =
-            parse_families(features.as_deref().unwrap_or(DEFAULT_FEATURES), alignment)
-                .map_err(lib)?;
-        if let Some(e) = families.extrinsic.as_mut() {
-            if let Some(n) = directions {
-                e.directions = n;
-            }
-            if let Some(n) = normals {
-                e.normal_directions = n;
-            }
+        let mut flags = FamilyFlags::default();
+        if let Some(f) = self.take("features")? {
+            flags.features = f;
         }
-        parse_family_weights(weights.as_deref().unwrap_or(""), &mut families.weights)
-            .map_err(lib)?;
-        p.families = families;
+        if let Some(u) = self.take("up")? {
+            flags.up = u;
+        }
+        if let Some(n) = self.take("directions")? {
+            flags.directions = n;
+        }
+        if let Some(n) = self.take("normals")? {
+            flags.normals = n;
+        }
+        if let Some(w) = self.take("family_weights")? {
+            flags.family_weights = w;
+        }
         if let Some(k) = self.take("eigenpairs")? {
             p.spectrum.eigenpairs = k;
         }
@@ -107,11 +96,8 @@ impl<'py> Opts<'py> {
         if self.take::<bool>("area_bands")? == Some(true) {
             p.bands.weighting = BandWeighting::Area;
         }
-        if !spectral {
-            p.descriptors.hks_count = 0;
-            p.descriptors.wks_count = 0;
-            p.descriptors.curvature_count = 0;
-        }
+        p.set_family_flags(&flags)
+            .map_err(|e: FeatureError| super::lib_err(&e))?;
         Ok(p)
     }
 
@@ -160,56 +146,49 @@ impl<'py> Opts<'py> {
         }))
     }
 
-    /// The collection stage's options, as `coseg segment` sets them.
-    pub fn segment(&mut self) -> PyResult<SegmentCollectionOptions> {
+    /// The segment job, as `coseg segment` sets it: the per-shape options, and the families
+    /// chosen from the data unless `features` is given.
+    pub fn segment(&mut self) -> PyResult<SegmentJob> {
         let lib = |e: GraphError| super::lib_err(&e);
-        let regions: Option<usize> = self.take("regions")?;
-        let parts = self
+        let mut job = SegmentJob::default();
+        job.choose_features = match &self.0 {
+            Some(d) => !d.get_item("features")?.is_some_and(|v| !v.is_none()),
+            None => true,
+        };
+        job.pipeline = self.pipeline()?;
+        job.regions = self.take("regions")?;
+        job.parts = self
             .take::<String>("parts")?
             .map(|p| p.parse::<PartsRequest>())
             .transpose()
             .map_err(lib)?;
-        let from = self
+        job.parts_from = self
             .take::<String>("parts_from")?
             .map(|f| f.parse::<PartsFrom>())
             .transpose()
             .map_err(lib)?;
-        // The mode as `coseg segment` reads it (the library's policy): parts by default,
-        // `regions` alone for equal-area regions.
-        let mut o2 = SegmentCollectionOptions::for_request(regions, parts, from);
-        o2.cosegment.area_fraction = self.take("area_fraction")?;
-        o2.cosegment.seed = self.take("seed")?;
-        if let Some(p) = o2.parts.as_mut() {
-            p.seed = o2.cosegment.seed;
-        }
+        job.snap_band = self.take("snap_band")?;
+        job.area_fraction = self.take("area_fraction")?;
+        job.seed = self.take("seed")?;
         if let Some(v) = self.take("complete_limit")? {
-            o2.graph.complete_limit = v;
+            job.graph.complete_limit = v;
         }
         if let Some(v) = self.take("neighbours")? {
-            o2.graph.neighbours = v;
+            job.graph.neighbours = v;
         }
-        let base = o2
-            .refine
-            .clone()
-            .unwrap_or(SegmentCollectionOptions::DEFAULT_REFINE);
-        let rounds = self.take("refine_rounds")?.unwrap_or(base.max_rounds);
-        let time = self.take("smoothing_time")?.unwrap_or(base.smoothing_time);
-        o2.refine = (rounds > 0).then_some({
-            let mut opts = RefineOptions::default();
-            opts.max_rounds = rounds;
-            opts.smoothing_time = time;
-            opts
-        });
+        if let Some(v) = self.take("refine_rounds")? {
+            job.refine_rounds = v;
+        }
+        if let Some(v) = self.take("smoothing_time")? {
+            job.smoothing_time = v;
+        }
         if let Some(n) = self.take("starts")? {
-            o2.starts = n;
+            job.starts = n;
         }
         if let Some(r) = self.take::<String>("refine_sizes")? {
-            o2.refine_sizes = r.parse::<RefineSizes>().map_err(lib)?;
+            job.refine_sizes = r.parse::<RefineSizes>().map_err(lib)?;
         }
-        if let Some(b) = self.take::<f64>("snap_band")? {
-            o2.set_snap_band(b).map_err(lib)?;
-        }
-        Ok(o2)
+        Ok(job)
     }
 
     /// The pair stage's options, as `coseg pair` sets them.
@@ -313,104 +292,4 @@ impl PairOpts {
             opts
         }
     }
-}
-
-/// Library defaults of every keyword the package exposes.
-pub fn defaults(py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
-    let d = PyDict::new(py);
-    let p = ShapePipelineOptions::default();
-    d.set_item("eigenpairs", p.spectrum.eigenpairs)?;
-    d.set_item("hks", p.descriptors.hks_count)?;
-    d.set_item("wks", p.descriptors.wks_count)?;
-    d.set_item("curvature", p.descriptors.curvature_count)?;
-    d.set_item("bands", p.bands.bands)?;
-    d.set_item("area_bands", p.bands.weighting == BandWeighting::Area)?;
-    d.set_item("features", DEFAULT_FEATURES)?;
-    d.set_item("up", DEFAULT_UP)?;
-    d.set_item("directions", ExtrinsicOptions::default().directions)?;
-    d.set_item("normals", ExtrinsicOptions::default().normal_directions)?;
-    let w = FamilyWeights::default();
-    let weights = PyDict::new(py);
-    weights.set_item("spectral", w.spectral)?;
-    weights.set_item("extrinsic", w.extrinsic)?;
-    weights.set_item("normals", w.normals)?;
-    weights.set_item("sdf", w.sdf)?;
-    weights.set_item("user", w.user)?;
-    d.set_item("family_weights", weights)?;
-    let s = SegmentCollectionOptions::default();
-    let refine = s
-        .refine
-        .clone()
-        .unwrap_or(SegmentCollectionOptions::DEFAULT_REFINE);
-    d.set_item("regions", s.cosegment.regions)?;
-    d.set_item("area_fraction", s.cosegment.area_fraction)?;
-    d.set_item("segment_seed", s.cosegment.seed)?;
-    d.set_item("complete_limit", s.graph.complete_limit)?;
-    d.set_item("neighbours", s.graph.neighbours)?;
-    d.set_item("segment_refine_rounds", refine.max_rounds)?;
-    d.set_item("segment_smoothing_time", refine.smoothing_time)?;
-    d.set_item("starts", s.starts)?;
-    d.set_item("refine_sizes", "free")?;
-    d.set_item(
-        "parts_from",
-        match s.parts_from {
-            PartsFrom::Adaptive => "adaptive",
-            PartsFrom::Geometry { .. } => "geometry",
-        },
-    )?;
-    d.set_item(
-        "parts",
-        match s.parts.as_ref().and_then(|p| p.parts) {
-            Some(k) => k.to_string(),
-            None => "auto".to_string(),
-        },
-    )?;
-    let a = coseg::parts::AdaptiveOptions::default();
-    d.set_item("max_parts", a.max_parts)?;
-    let r = StableRegionsOptions::default();
-    d.set_item(
-        "algorithm",
-        match r.algorithm {
-            Algorithm::Fixed => "fixed",
-            Algorithm::Auto => "auto",
-        },
-    )?;
-    d.set_item("pairs", r.pairs)?;
-    if let Threshold::AreaFraction(a) = r.p {
-        d.set_item("alpha", a)?;
-    }
-    d.set_item(
-        "alpha_of_remaining",
-        r.area_reference == AreaReference::Remaining,
-    )?;
-    d.set_item("delta_t", r.delta_t)?;
-    d.set_item("t_max", r.t_max)?;
-    d.set_item("linear_t", r.t_search == TSearch::Linear)?;
-    d.set_item(
-        "init",
-        match r.init {
-            Init::Extreme => "extreme",
-            Init::Random => "random",
-        },
-    )?;
-    d.set_item("pair_seed", r.seed)?;
-    d.set_item("max_iterations", r.max_iterations)?;
-    let pr = RefineOptions::default();
-    d.set_item("pair_refine_rounds", pr.max_rounds)?;
-    d.set_item("pair_smoothing_time", pr.smoothing_time)?;
-    let po = PropagateOptions::default();
-    d.set_item("propagate_smoothing_time", po.smoothing_time)?;
-    d.set_item("max_sweeps", po.max_sweeps)?;
-    d.set_item("network_weight", po.network_weight)?;
-    d.set_item("similarity_power", po.similarity_power)?;
-    d.set_item("size_prior", po.size_prior)?;
-    d.set_item("area_weighted", po.area_weighted)?;
-    d.set_item("map_agreement", MapStepOptions::default().min_agreement)?;
-    d.set_item("map_preset", "auto")?;
-    d.set_item("map_size", ZoomOutOptions::default().final_size)?;
-    d.set_item(
-        "map_smoothing_time",
-        MapGuidedOptions::default().smoothing_time,
-    )?;
-    Ok(d)
 }

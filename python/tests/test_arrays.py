@@ -80,24 +80,36 @@ def test_features_names_families_and_table():
                 assert lo.max() <= hi.min()
 
 
-def test_defaults_are_the_library_defaults():
+def test_every_keyword_default_is_the_librarys():
+    """Generated from the signatures: every keyword of every public function whose default is
+    set must be the library's (``coseg.DEFAULTS``, ``coseg::jobs::defaults``): the command's
+    own, else the per-shape one. A keyword the library does not export fails here too."""
     import inspect
 
+    import coseg.dask
+
     d = coseg.DEFAULTS
-    assert d["eigenpairs"] == 200 and d["bands"] == 20 and d["regions"] == 6
-    sig = inspect.signature(coseg.segment).parameters
-    # None: parts (12 equal-area leaves grouped, their number chosen), as the bare CLI; alone,
-    # that many equal-area regions; with parts_from="adaptive", an upper bound of 8 parts.
-    assert sig["regions"].default is None and d["max_parts"] == 8
-    assert d["parts_from"] == "geometry" and d["parts"] == "auto"
-    assert sig["parts_from"].default is None and sig["families"].default is None
-    assert sig["eigenpairs"].default == d["eigenpairs"]
-    assert sig["starts"].default == d["starts"] == 1 and sig["refine_sizes"].default == "free"
-    assert sig["normals"].default == d["normals"] == 0
-    p = inspect.signature(coseg.propagate).parameters
-    assert p["area_weighted"].default == d["area_weighted"] is False
-    assert p["map_agreement"].default == d["map_agreement"] == 0.8
-    assert inspect.signature(coseg.pair).parameters["pairs"].default == d["pairs"]
+    # Two keywords the Python package names differently from the flags.
+    flag_of = {"families": "features", "k": "eigenpairs"}
+    checked, wrong = 0, []
+    for module in (coseg,):
+        for name in module.__all__:
+            f = getattr(module, name)
+            if not inspect.isfunction(f):
+                continue
+            for p in inspect.signature(f).parameters.values():
+                if p.default is inspect.Parameter.empty or p.default is None:
+                    continue
+                key = flag_of.get(p.name, p.name)
+                missing = object()
+                lib = d.get(name, {}).get(key, d["pipeline"].get(key, missing))
+                if lib is missing or lib != p.default or type(lib) is not type(p.default):
+                    wrong.append(f"{module.__name__}.{name}({p.name}={p.default!r}): library {lib!r}")
+                else:
+                    checked += 1
+    assert not wrong, "\n".join(wrong)
+    assert checked > 60
+    assert d["pipeline"]["eigenpairs"] == 200 and d["segment"]["regions"] is None
 
 
 def test_trimesh_objects_are_accepted():

@@ -17,12 +17,10 @@
 //! - [`align_collection`]`(meshes, &`[`AlignOptions`]`) -> Result<`[`CollectionAlignment`]`, `[`AlignError`]`>`:
 //!   a similarity per shape into one collection frame (registrations over a shape graph,
 //!   synchronised), a confidence per shape, the already-aligned case kept exactly, the up and
-//!   forward axes;
-//! - [`align_folder`]: `coseg align FOLDER -o OUT` as a job (`transforms.json`, aligned meshes
-//!   on request).
+//!   forward axes; `coseg align FOLDER -o OUT` is the job
+//!   [`run_align`](crate::jobs::run_align).
 
 mod align_collection;
-mod align_folder;
 mod closest_surface_points;
 mod nearest_point_labels;
 mod register_pair;
@@ -32,7 +30,6 @@ mod surface_samples;
 pub use align_collection::{
     AlignOptions, CollectionAlignment, FrameCase, ShapeAlignment, align_collection,
 };
-pub use align_folder::{AlignFolderOptions, AlignFolderReport, align_folder};
 pub use closest_surface_points::{SurfaceIndex, SurfacePoint, closest_surface_points};
 pub use nearest_point_labels::{nearest_point_labels, nearest_point_vertex_labels};
 pub use register_pair::{Candidate, RegisterOptions, Registration, register_pair};

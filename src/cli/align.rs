@@ -1,6 +1,9 @@
+//! `coseg align FOLDER -o OUT`: every mesh of a folder in one collection frame.
+
 use anyhow::Result;
 use clap::Args;
-use coseg::align::{AlignFolderOptions, FrameCase, align_folder};
+use coseg::align::{AlignOptions, FrameCase};
+use coseg::jobs::{AlignJob, run_align};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -16,15 +19,21 @@ pub struct AlignArgs {
     #[arg(long)]
     write_meshes: bool,
     /// Registration-graph neighbours per shape.
-    #[arg(long, default_value_t = 4)]
+    #[arg(long, default_value_t = AlignOptions::default().neighbours)]
     neighbours: usize,
 }
 
+/// The job `coseg align` runs with these flags (the flags translated, nothing else).
+fn align_job(args: &AlignArgs) -> AlignJob {
+    let mut job = AlignJob::default();
+    job.write_meshes = args.write_meshes;
+    job.align.neighbours = args.neighbours;
+    job.output = Some(args.output.clone());
+    job
+}
+
 pub fn run(args: AlignArgs) -> Result<ExitCode> {
-    let mut options = AlignFolderOptions::default();
-    options.write_meshes = args.write_meshes;
-    options.align.neighbours = args.neighbours;
-    let r = align_folder(&args.folder, &args.output, &options)?;
+    let r = run_align(&args.folder, &align_job(&args))?;
     let a = &r.alignment;
     let case = match a.case {
         FrameCase::AlreadyAligned => "already aligned: the given frames agree, kept unchanged",
@@ -55,4 +64,25 @@ pub fn run(args: AlignArgs) -> Result<ExitCode> {
         }
     }
     Ok(ExitCode::SUCCESS)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: AlignArgs,
+    }
+
+    /// The bare command runs the job's default: the CLI chooses no default of its own.
+    #[test]
+    fn the_bare_command_runs_the_default_job() {
+        let cli = Cli::parse_from(["coseg", "shapes", "-o", "out"]);
+        let mut want = AlignJob::default();
+        want.output = Some(PathBuf::from("out"));
+        assert_eq!(align_job(&cli.args), want);
+    }
 }

@@ -20,9 +20,9 @@ pub struct FeaturesArgs {
     /// Output directory (created if missing).
     #[arg(short, long)]
     output: PathBuf,
-    /// File format of the tables.
-    #[arg(long, value_enum, default_value = "npy")]
-    format: Format,
+    /// File format of the tables. [default: npy]
+    #[arg(long, value_enum)]
+    format: Option<Format>,
     /// Also write the unit-area spectrum (eigenvalues, eigenvectors, vertex areas).
     #[arg(long)]
     spectrum: bool,
@@ -67,8 +67,9 @@ pub fn run(args: FeaturesArgs) -> Result<ExitCode> {
         }
     };
     let format = match args.format {
-        Format::Npy => ExportFormat::Npy,
-        Format::Csv => ExportFormat::Csv,
+        Some(Format::Npy) => ExportFormat::Npy,
+        Some(Format::Csv) => ExportFormat::Csv,
+        None => ExportFormat::default(),
     };
     let written = export_features(
         &args.output,

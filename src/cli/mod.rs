@@ -137,6 +137,11 @@ pub fn quiet() -> bool {
     global().quiet
 }
 
+/// True with `--strict`: fail when an input file cannot be used.
+pub fn strict() -> bool {
+    global().strict
+}
+
 /// Fails under `--strict` when `skipped` input files could not be used.
 pub fn check_strict(skipped: usize) -> anyhow::Result<()> {
     if global().strict && skipped > 0 {
@@ -232,5 +237,62 @@ fn exit_code(failed: usize, total: usize) -> ExitCode {
         ExitCode::from(EXIT_FAILURE)
     } else {
         ExitCode::from(EXIT_PARTIAL)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::{ArgAction, CommandFactory};
+    use serde_json::Value;
+
+    /// Every flag default of every subcommand is the library's ([`coseg::jobs::defaults`]: the
+    /// subcommand's own, else the per-shape one). Generated from clap's description of the
+    /// command line, so a flag given a default of its own (or one the library does not
+    /// export) fails here.
+    #[test]
+    fn every_flag_default_is_the_librarys() {
+        let lib = coseg::jobs::defaults();
+        let mut checked = 0;
+        let mut wrong = Vec::new();
+        for sub in Cli::command().get_subcommands() {
+            for arg in sub.get_arguments() {
+                // A switch's "default" is its absence, not a value of the library's.
+                if !matches!(arg.get_action(), ArgAction::Set | ArgAction::Append) {
+                    continue;
+                }
+                let shown: Vec<String> = arg
+                    .get_default_values()
+                    .iter()
+                    .map(|v| v.to_string_lossy().into_owned())
+                    .collect();
+                if shown.is_empty() {
+                    continue;
+                }
+                let id = arg.get_id().as_str();
+                let value = lib[sub.get_name()]
+                    .get(id)
+                    .or_else(|| lib["pipeline"].get(id));
+                match value {
+                    Some(v) if same(v, &shown.join(",")) => checked += 1,
+                    _ => wrong.push(format!(
+                        "{} --{id}: flag default {shown:?}, library {value:?}",
+                        sub.get_name()
+                    )),
+                }
+            }
+        }
+        assert!(wrong.is_empty(), "{}", wrong.join("\n"));
+        assert!(checked > 40, "only {checked} defaults checked");
+    }
+
+    /// A JSON value and the text clap shows for it: equal as numbers, switches or words.
+    fn same(v: &Value, shown: &str) -> bool {
+        match v {
+            Value::String(s) => s == shown,
+            Value::Bool(b) => shown.parse::<bool>() == Ok(*b),
+            Value::Number(n) => n.as_f64().is_some() && n.as_f64() == shown.parse::<f64>().ok(),
+            _ => false,
+        }
     }
 }

@@ -56,15 +56,16 @@ pub struct PairArgs {
     /// Do not draw `preview.png`, `<name>.png` and `index.html`.
     #[arg(long)]
     no_pictures: bool,
-    /// Algorithm 2 (fixed) or 3 (auto).
-    #[arg(long, value_enum, default_value = "fixed")]
-    algorithm: AlgorithmArg,
+    /// Algorithm 2 (fixed) or 3 (auto). [default: fixed]
+    #[arg(long, value_enum)]
+    algorithm: Option<AlgorithmArg>,
     /// Number of region pairs K (the last one is the leftovers).
     #[arg(long, default_value_t = StableRegionsOptions::default().pairs)]
     pairs: usize,
     /// Algorithm 2's area cutoff α (fraction of each shape's total area per pair).
-    #[arg(long, default_value_t = default_alpha())]
-    alpha: f64,
+    /// [default: 0.1]
+    #[arg(long)]
+    alpha: Option<f64>,
     /// Algorithm 2: α is a fraction of the remaining area instead of the total.
     #[arg(long)]
     alpha_of_remaining: bool,
@@ -77,9 +78,9 @@ pub struct PairArgs {
     /// Algorithm 3: step t linearly as the paper does (slower) instead of bisecting.
     #[arg(long)]
     linear_t: bool,
-    /// Initial indicators.
-    #[arg(long, value_enum, default_value = "random")]
-    init: InitArg,
+    /// Initial indicators. [default: random]
+    #[arg(long, value_enum)]
+    init: Option<InitArg>,
     /// Seed of the random initial indicators.
     #[arg(long, default_value_t = StableRegionsOptions::default().seed)]
     seed: u64,
@@ -104,9 +105,9 @@ pub struct PairArgs {
     /// descriptors in the point map's last match; TOSCA within-class 95.7 % against 94.3 %,
     /// but worse on different bodies), `general`, or `auto`, which picks `near-isometric`
     /// when the two spectra agree (eigenvalue discrepancy below 0.03, see
-    /// `coseg::maps::map_preset`).
-    #[arg(long, value_enum, default_value = "auto")]
-    map_preset: MapPresetArg,
+    /// `coseg::maps::map_preset`). [default: auto]
+    #[arg(long, value_enum)]
+    map_preset: Option<MapPresetArg>,
     /// Same as `--map-preset near-isometric`.
     #[arg(long, conflicts_with = "map_preset")]
     near_isometric: bool,
@@ -132,23 +133,20 @@ pub struct PairArgs {
 }
 
 /// Algorithm 2's default area cut-off α, as the library sets it.
-fn default_alpha() -> f64 {
-    match StableRegionsOptions::default().p {
-        Threshold::AreaFraction(a) => a,
-        _ => 0.1,
-    }
-}
-
 /// The algorithm's options the flags select.
 fn region_options(args: &PairArgs) -> StableRegionsOptions {
     let mut opts = StableRegionsOptions::default();
-    opts.algorithm = match args.algorithm {
-        AlgorithmArg::Fixed => Algorithm::Fixed,
-        AlgorithmArg::Auto => Algorithm::Auto,
-    };
+    if let Some(a) = args.algorithm {
+        opts.algorithm = match a {
+            AlgorithmArg::Fixed => Algorithm::Fixed,
+            AlgorithmArg::Auto => Algorithm::Auto,
+        };
+    }
     opts.pairs = args.pairs;
-    opts.p = Threshold::AreaFraction(args.alpha);
-    opts.q = Threshold::AreaFraction(args.alpha);
+    if let Some(alpha) = args.alpha {
+        opts.p = Threshold::AreaFraction(alpha);
+        opts.q = Threshold::AreaFraction(alpha);
+    }
     opts.area_reference = if args.alpha_of_remaining {
         AreaReference::Remaining
     } else {
@@ -161,10 +159,12 @@ fn region_options(args: &PairArgs) -> StableRegionsOptions {
     } else {
         TSearch::Bisect
     };
-    opts.init = match args.init {
-        InitArg::Extreme => Init::Extreme,
-        InitArg::Random => Init::Random,
-    };
+    if let Some(init) = args.init {
+        opts.init = match init {
+            InitArg::Extreme => Init::Extreme,
+            InitArg::Random => Init::Random,
+        };
+    }
     opts.seed = args.seed;
     opts.max_iterations = args.max_iterations;
     opts
@@ -178,13 +178,12 @@ fn map_step(args: &PairArgs) -> MapStep {
         final_size: args.map_size,
         smoothing_time: args.map_smoothing_time,
     };
-    match (args.near_isometric, args.map_preset) {
-        (true, _) | (false, MapPresetArg::NearIsometric) => {
-            MapStep::Preset(MapPreset::NearIsometric, overrides)
-        }
-        (false, MapPresetArg::General) => MapStep::Preset(MapPreset::General, overrides),
-        (false, MapPresetArg::Auto) => MapStep::Auto(overrides),
-    }
+    let preset = match (args.near_isometric, args.map_preset) {
+        (true, _) | (false, Some(MapPresetArg::NearIsometric)) => Some(MapPreset::NearIsometric),
+        (false, Some(MapPresetArg::General)) => Some(MapPreset::General),
+        (false, Some(MapPresetArg::Auto) | None) => None,
+    };
+    MapStep::with_preset(preset, overrides)
 }
 
 pub fn run(args: PairArgs) -> Result<ExitCode> {

@@ -2,8 +2,8 @@
 
 use clap::Args;
 use coseg::bands::BandWeighting;
-use coseg::features::ExtrinsicOptions;
-use coseg::pipeline::ShapePipelineOptions;
+use coseg::pipeline::{FamilyFlags, ShapePipelineOptions};
+use coseg::spectral::LaplacianKind;
 
 #[derive(Debug, Args)]
 pub struct PipelineArgs {
@@ -32,26 +32,26 @@ pub struct PipelineArgs {
     #[arg(long)]
     features: Option<String>,
     /// Frame of the extrinsic family: the collection's up axis (x, y, z, -x, …) when it is
-    /// already aligned, or pca.
-    #[arg(long, default_value = "y")]
-    up: String,
+    /// already aligned, or pca. [default: y]
+    #[arg(long)]
+    up: Option<String>,
     /// Number of height directions of the extrinsic family.
-    #[arg(long, default_value_t = ExtrinsicOptions::default().directions)]
+    #[arg(long, default_value_t = FamilyFlags::default().directions)]
     directions: usize,
     /// Number of normal columns of the extrinsic family (|normal · direction|; 0 = none).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = FamilyFlags::default().normals)]
     normals: usize,
     /// Triangulation of the spectral family's Laplacian: cotan (the mesh's triangles) or
     /// intrinsic-delaunay (edges flipped intrinsically until every cotangent weight is
     /// non-negative; for CAD exports and poor triangulations). See docs/FEATURES.md.
-    #[arg(long, default_value = "cotan")]
-    laplacian: String,
+    #[arg(long, default_value_t = ShapePipelineOptions::default().spectrum.laplacian)]
+    laplacian: LaplacianKind,
     /// Family weights in the affinity, e.g. spectral=1,extrinsic=2,normals=1 (a family's total
     /// share; default 1 each; `normals` = the extrinsic family's `--normals` columns, weighted
     /// as a family of their own). Used by `coseg segment`, `coseg propagate` and `coseg pair` (all its
     /// stages).
-    #[arg(long, default_value = "")]
-    family_weights: String,
+    #[arg(long)]
+    family_weights: Option<String>,
 }
 
 impl PipelineArgs {
@@ -64,7 +64,7 @@ impl PipelineArgs {
     pub fn options(&self) -> anyhow::Result<ShapePipelineOptions> {
         let mut opts = ShapePipelineOptions::default();
         opts.spectrum.eigenpairs = self.eigenpairs;
-        opts.spectrum.laplacian = self.laplacian.parse().map_err(anyhow::Error::msg)?;
+        opts.spectrum.laplacian = self.laplacian;
         opts.descriptors.hks_count = self.hks;
         opts.descriptors.wks_count = self.wks;
         opts.descriptors.curvature_count = self.curvature;
@@ -72,13 +72,19 @@ impl PipelineArgs {
         if self.area_bands {
             opts.bands.weighting = BandWeighting::Area;
         }
-        opts.set_families(
-            self.features.as_deref().unwrap_or("spectral"),
-            &self.up,
-            self.directions,
-            self.normals,
-            &self.family_weights,
-        )?;
+        let mut flags = FamilyFlags::default();
+        if let Some(f) = &self.features {
+            flags.features = f.clone();
+        }
+        if let Some(u) = &self.up {
+            flags.up = u.clone();
+        }
+        flags.directions = self.directions;
+        flags.normals = self.normals;
+        if let Some(w) = &self.family_weights {
+            flags.family_weights = w.clone();
+        }
+        opts.set_family_flags(&flags)?;
         Ok(opts)
     }
 }

@@ -3,7 +3,6 @@
 
 use anyhow::{Result, bail};
 use clap::Args;
-use coseg::graph::GraphOptions;
 use coseg::jobs::{CacheChoice, PropagateInput, PropagateJob, run_propagate};
 use coseg::propagate::{MapStepOptions, PartScore, PropagateOptions};
 use std::path::PathBuf;
@@ -34,10 +33,10 @@ pub struct PropagateArgs {
     cache: Option<PathBuf>,
     /// Collections up to this size use a complete shape graph; larger ones a nearest-neighbour
     /// graph.
-    #[arg(long, default_value_t = GraphOptions::default().complete_limit)]
+    #[arg(long, default_value_t = PropagateJob::default().propagation.graph.complete_limit)]
     complete_limit: usize,
     /// Neighbours per shape of the nearest-neighbour graph.
-    #[arg(long, default_value_t = GraphOptions::default().neighbours)]
+    #[arg(long, default_value_t = PropagateJob::default().propagation.graph.neighbours)]
     neighbours: usize,
     /// Heat-smoothing time of the part scores (unit-area surface; 0 = no smoothing).
     #[arg(long, default_value_t = PropagateOptions::default().smoothing_time)]
@@ -57,8 +56,9 @@ pub struct PropagateArgs {
     size_prior: f64,
     /// Part score: affinity (mean of the per-feature histogram values, the band affinity's
     /// transport) or geometric (their geometric mean). See docs/PROPAGATION.md.
-    #[arg(long, default_value = "affinity")]
-    part_score: String,
+    /// [default: affinity]
+    #[arg(long)]
+    part_score: Option<String>,
     /// Weigh the parts' band histograms by vertex area (true) or vertex count (false).
     #[arg(long, default_value_t = PropagateOptions::default().area_weighted, action = clap::ArgAction::Set)]
     area_weighted: bool,
@@ -93,11 +93,13 @@ fn propagate_job(args: &PropagateArgs) -> Result<PropagateJob> {
     options.propagate.network_weight = args.network_weight;
     options.propagate.similarity_power = args.similarity_power;
     options.propagate.size_prior = args.size_prior;
-    options.propagate.part_score = match args.part_score.as_str() {
-        "affinity" => PartScore::Affinity,
-        "geometric" => PartScore::Geometric,
-        o => bail!("--part-score {o}: expected affinity or geometric"),
-    };
+    if let Some(score) = &args.part_score {
+        options.propagate.part_score = match score.as_str() {
+            "affinity" => PartScore::Affinity,
+            "geometric" => PartScore::Geometric,
+            o => bail!("--part-score {o}: expected affinity or geometric"),
+        };
+    }
     options.propagate.area_weighted = args.area_weighted;
     options.propagate.refit_rounds = args.refit_rounds;
     options.propagate.refit_weight = args.refit_weight;

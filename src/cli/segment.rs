@@ -1,19 +1,17 @@
 //! `coseg segment FOLDER -o OUT`: consistent co-segmentation of every mesh in a folder.
 
-use anyhow::{Context, Result, bail};
+use anyhow::{Result, bail};
 use clap::Args;
 use coseg::cache::CacheOutcome;
-use coseg::graph::{GraphError, GraphOptions, LoadedCollection, RefineSizes, load_collection};
-use coseg::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
-use coseg::parts::{
-    PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentedCollection, segment_collection,
+use coseg::graph::{GraphError, RefineSizes};
+use coseg::jobs::{
+    CacheChoice, JobError, SegmentInput, SegmentJob, SegmentOutcome, SegmentProgress,
+    run_segment_with_progress,
 };
-use coseg::pipeline::ShapePipelineOptions;
-use coseg::render::{RenderOptions, RenderShape};
-use coseg::stable::RefineOptions;
-use std::path::{Path, PathBuf};
+use coseg::parts::{PartsFrom, PartsRequest};
+use std::path::PathBuf;
 use std::process::ExitCode;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
 #[derive(Debug, Args)]
 pub struct SegmentArgs {
@@ -60,18 +58,18 @@ pub struct SegmentArgs {
     /// Co-segment from this many starts (the default start, then seeded ones) and keep the one
     /// with the highest mean region confidence; equal-area mode only (an error with
     /// `--parts`). See docs/PARTS.md.
-    #[arg(long, default_value_t = SegmentCollectionOptions::default().starts)]
+    #[arg(long, default_value_t = SegmentJob::default().starts)]
     starts: usize,
     /// Collections up to this size use a complete shape graph; larger ones a nearest-neighbour
     /// graph.
-    #[arg(long, default_value_t = GraphOptions::default().complete_limit)]
+    #[arg(long, default_value_t = SegmentJob::default().graph.complete_limit)]
     complete_limit: usize,
     /// Neighbours per shape of the nearest-neighbour graph.
-    #[arg(long, default_value_t = GraphOptions::default().neighbours)]
+    #[arg(long, default_value_t = SegmentJob::default().graph.neighbours)]
     neighbours: usize,
     /// Sweeps of boundary refinement after the co-segmentation (smoothed best responses over
     /// every graph edge, see `coseg::graph::refine_cosegmentation`); 0 keeps the raw regions.
-    #[arg(long, default_value_t = SegmentCollectionOptions::DEFAULT_REFINE.max_rounds)]
+    #[arg(long, default_value_t = SegmentJob::default().refine_rounds)]
     refine_rounds: usize,
     /// How the refinement treats part sizes: `free` (default: the classic best response,
     /// which drifts towards equal areas), `keep` (each part's area on each shape stays within
@@ -81,7 +79,7 @@ pub struct SegmentArgs {
     #[arg(long, value_parser = parse_refine_sizes)]
     refine_sizes: Option<RefineSizes>,
     /// Heat-smoothing time of the refinement (unit-area surface; 0 = no smoothing).
-    #[arg(long, default_value_t = SegmentCollectionOptions::DEFAULT_REFINE.smoothing_time)]
+    #[arg(long, default_value_t = SegmentJob::default().smoothing_time)]
     smoothing_time: f64,
     #[command(flatten)]
     pipeline: super::pipeline_args::PipelineArgs,
@@ -102,227 +100,157 @@ fn parse_parts(s: &str) -> Result<PartsRequest, String> {
     s.parse().map_err(|e: GraphError| e.to_string())
 }
 
-pub fn run(args: SegmentArgs) -> Result<ExitCode> {
-    let cache = args
+/// The job `coseg segment` runs with these flags (the flags translated, nothing else).
+fn segment_job(args: &SegmentArgs) -> Result<SegmentJob> {
+    let mut job = SegmentJob::default();
+    job.pipeline = args.pipeline.options()?;
+    job.choose_features = !args.pipeline.features_given();
+    job.regions = args.regions;
+    job.parts = args.parts;
+    job.parts_from = args.parts_from;
+    job.snap_band = args.snap_band;
+    job.area_fraction = args.area_fraction;
+    job.seed = args.seed;
+    job.starts = args.starts;
+    job.graph.complete_limit = args.complete_limit;
+    job.graph.neighbours = args.neighbours;
+    job.refine_rounds = args.refine_rounds;
+    job.smoothing_time = args.smoothing_time;
+    if let Some(r) = args.refine_sizes {
+        job.refine_sizes = r;
+    }
+    job.cache = args
         .cache
         .clone()
-        .unwrap_or_else(|| args.out.join(".cache"));
-    let pipeline = args.pipeline.options()?;
+        .map_or(CacheChoice::Auto, CacheChoice::Dir);
+    job.output = Some(args.out.clone());
+    job.pictures = !args.no_pictures;
+    job.strict = super::strict();
+    Ok(job)
+}
+
+pub fn run(args: SegmentArgs) -> Result<ExitCode> {
     let t0 = Instant::now();
+    let job = segment_job(&args)?;
     let bar = super::progress_bar(0);
-    let loaded = load_collection(&args.folder, &pipeline, &cache, |i, total, path| {
-        if let Some(b) = &bar {
-            b.set_length(total as u64);
-            b.set_position(i as u64);
-            b.set_message(path.display().to_string());
-        }
-    })
-    .with_context(|| format!("reading {}", args.folder.display()))?;
-    if let Some(b) = &bar {
+    let mut spin = None;
+    let outcome =
+        run_segment_with_progress(
+            SegmentInput::Folder(args.folder.clone()),
+            &job,
+            |p| match p {
+                SegmentProgress::Shape { done, total, file } => {
+                    if let Some(b) = &bar {
+                        b.set_length(total as u64);
+                        b.set_position(done as u64);
+                        b.set_message(file.display().to_string());
+                    }
+                }
+                SegmentProgress::Stage(stage) => {
+                    if let Some(b) = &bar {
+                        b.finish_and_clear();
+                    }
+                    if let Some(b) = spin.replace(super::spinner(stage)).flatten() {
+                        b.finish_and_clear();
+                    }
+                }
+                _ => {}
+            },
+        );
+    if let Some(b) = spin.flatten() {
         b.finish_and_clear();
     }
-    for s in &loaded.skipped {
-        eprintln!("error: {} (skipped)", s.error);
-    }
-    for w in &loaded.warnings {
-        super::warn(w);
-    }
-    super::check_strict(loaded.skipped.len())?;
-    let total_files = loaded.nodes.len() + loaded.skipped.len();
-    if total_files == 0 {
-        bail!(
-            "{}: no mesh files (.obj, .off, .ply)",
-            args.folder.display()
-        );
-    }
-    if loaded.nodes.len() < 2 {
-        bail!(
-            "{}: co-segmentation needs at least 2 readable shapes, got {}",
-            args.folder.display(),
-            loaded.nodes.len()
-        );
-    }
-    let options = collection_options(&args, &pipeline, &loaded, &cache)?;
-    let spin = super::spinner("co-segmentation and refinement");
-    let result = segment_collection(loaded.nodes.clone(), &loaded.meshes, &options)?;
-    if let Some(b) = spin {
-        b.finish_and_clear();
-    }
-    for w in &result.warnings {
-        super::warn(w);
-    }
-    if !super::quiet() {
-        if let Some(f) = &result.features {
-            println!("{}", f.reason);
-        }
-        if let Some(c) = &result.part_count {
-            println!("{}", c.reason);
-        }
-    }
-    let seg = &result.segmentation;
-    let t_write = Instant::now();
-    let files: Vec<String> = loaded
-        .paths
-        .iter()
-        .map(|p| p.display().to_string())
-        .collect();
-    let skipped = loaded.skipped.iter().map(SkippedInput::from).collect();
-    let mut summary = CollectionSummary::new(&result, &files, &options, skipped);
-    if let (Some(a), Some(report)) = (&result.adaptive, result.parts_report(&loaded.meshes)) {
-        if !super::quiet() {
-            println!(
-                "parts: {} finest{} ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}; mirror pairs (left/right copies): {:?}",
-                a.leaves.tuples.len(),
-                match report
-                    .leaf_origin
-                    .iter()
-                    .enumerate()
-                    .filter(|&(i, &o)| i != o)
-                    .count()
-                {
-                    0 => String::new(),
-                    n => format!(
-                        ", {n} of them pieces split off their regions{}",
-                        match report.leaf_copies.len() {
-                            0 => String::new(),
-                            c => format!(", {c} pairs of those copies of one part"),
-                        }
-                    ),
-                },
-                a.stop,
-                seg.tuples.len(),
-                report.mirror_candidates,
-                report
-                    .mirror_pairs
-                    .iter()
-                    .map(|m| (m.a, m.b))
-                    .collect::<Vec<_>>()
+    let outcome = match outcome {
+        Err(JobError::Skipped(skipped)) => {
+            for s in &skipped {
+                eprintln!("error: {} (skipped)", s.error);
+            }
+            bail!(
+                "{} input file(s) could not be used (--strict)",
+                skipped.len()
             );
         }
-        if let Some(w) = report.warning() {
-            super::warn(w);
-        }
-        summary.parts = Some(report);
+        o => o?,
+    };
+    for s in &outcome.skipped {
+        eprintln!("error: {} (skipped)", s.error);
     }
-    let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
-    let shapes = ShapeRegions::collection(&seg.names, &loaded.meshes, &labels);
-    let mut written = write_regions(&args.out, &shapes, &summary)?;
-    if !args.no_pictures {
-        written.extend(draw(&args.out, &shapes, &summary)?);
+    for w in &outcome.warnings {
+        super::warn(w);
     }
-    let write_time = t_write.elapsed();
     if !super::quiet() {
-        report(
-            &args,
-            &loaded,
-            &result,
-            &options,
-            written.len(),
-            write_time,
-            t0,
+        print_result(&args, &outcome, t0);
+    }
+    Ok(super::exit_code(
+        outcome.skipped.len(),
+        outcome.total_files(),
+    ))
+}
+
+/// What the run chose and found, then the one-screen summary.
+fn print_result(args: &SegmentArgs, outcome: &SegmentOutcome, t0: Instant) {
+    let result = &outcome.result;
+    if let Some(f) = &result.features {
+        println!("{}", f.reason);
+    }
+    if let Some(c) = &result.part_count {
+        println!("{}", c.reason);
+    }
+    if let (Some(a), Some(report)) = (&result.adaptive, &outcome.summary.parts) {
+        println!(
+            "parts: {} finest{} ({:?}), {} written; mirror candidates (several pieces, both sides?): {:?}; mirror pairs (left/right copies): {:?}",
+            a.leaves.tuples.len(),
+            match report
+                .leaf_origin
+                .iter()
+                .enumerate()
+                .filter(|&(i, &o)| i != o)
+                .count()
+            {
+                0 => String::new(),
+                n => format!(
+                    ", {n} of them pieces split off their regions{}",
+                    match report.leaf_copies.len() {
+                        0 => String::new(),
+                        c => format!(", {c} pairs of those copies of one part"),
+                    }
+                ),
+            },
+            a.stop,
+            result.segmentation.tuples.len(),
+            report.mirror_candidates,
+            report
+                .mirror_pairs
+                .iter()
+                .map(|m| (m.a, m.b))
+                .collect::<Vec<_>>()
         );
     }
-    Ok(super::exit_code(loaded.skipped.len(), total_files))
-}
-
-/// The collection stage's options the flags select.
-fn collection_options(
-    args: &SegmentArgs,
-    pipeline: &ShapePipelineOptions,
-    loaded: &LoadedCollection,
-    cache: &Path,
-) -> Result<SegmentCollectionOptions> {
-    let mut o2 = SegmentCollectionOptions::for_request(args.regions, args.parts, args.parts_from);
-    o2.graph = {
-        let mut opts = GraphOptions::default();
-        opts.complete_limit = args.complete_limit;
-        opts.neighbours = args.neighbours;
-        opts
-    };
-    o2.cosegment = {
-        let mut opts = o2.cosegment;
-        opts.area_fraction = args.area_fraction;
-        opts.seed = args.seed;
-        opts
-    };
-    o2.refine = (args.refine_rounds > 0).then_some({
-        let mut opts = RefineOptions::default();
-        opts.max_rounds = args.refine_rounds;
-        opts.smoothing_time = args.smoothing_time;
-        opts
-    });
-    o2.starts = args.starts;
-    o2.refine_sizes = args.refine_sizes.unwrap_or_default();
-    o2.set_pipeline(
-        pipeline,
-        args.pipeline.features_given(),
-        loaded.nodes[0].bands.features,
-    );
-    if let Some(p) = o2.parts.as_mut() {
-        p.seed = args.seed;
-    }
-    if let Some(band) = args.snap_band {
-        o2.set_snap_band(band)?;
-    }
-    o2.cue_cache = Some(cache.to_path_buf());
-    Ok(o2)
-}
-
-/// preview.png, <name>.png and index.html, legends naming each region by its confidence.
-fn draw(
-    out: &std::path::Path,
-    shapes: &[ShapeRegions],
-    summary: &CollectionSummary,
-) -> Result<Vec<PathBuf>> {
-    let spin = super::spinner("pictures");
-    let pictures: Vec<RenderShape> = shapes.iter().map(ShapeRegions::picture).collect();
-    let names: Vec<String> = summary
-        .regions
-        .iter()
-        .map(|r| {
-            if r.leftover {
-                "leftovers".to_string()
-            } else {
-                format!("({:.0}%)", 100.0 * r.confidence)
-            }
-        })
-        .collect();
-    let paths = write_visuals(out, &pictures, Some(&names), &RenderOptions::default())?;
-    if let Some(b) = spin {
-        b.finish_and_clear();
-    }
-    Ok(paths)
+    report(args, outcome, t0);
 }
 
 /// The one-screen summary on stdout: shapes, regions, times, where the results are.
-fn report(
-    args: &SegmentArgs,
-    loaded: &LoadedCollection,
-    result: &SegmentedCollection,
-    options: &SegmentCollectionOptions,
-    written: usize,
-    write_time: Duration,
-    t0: Instant,
-) {
+fn report(args: &SegmentArgs, outcome: &SegmentOutcome, t0: Instant) {
+    let (result, options) = (&outcome.result, &outcome.options);
     let seg = &result.segmentation;
-    let total_files = loaded.nodes.len() + loaded.skipped.len();
-    let hits = loaded
-        .outcomes
+    let total_files = outcome.total_files();
+    let hits = outcome
+        .cache_outcomes
         .iter()
-        .filter(|o| **o == CacheOutcome::Hit)
+        .filter(|o| **o == Some(CacheOutcome::Hit))
         .count();
     println!(
         "{} shapes co-segmented into {} regions; {} files in {}",
-        loaded.nodes.len(),
+        outcome.files.len(),
         seg.tuples.len(),
-        written,
+        outcome.written.len(),
         args.out.display()
     );
     let times = &result.times;
     println!(
         "time: read {:.2} s, per-shape data {:.2} s ({hits} cached), {}graph {:.2} s, co-segmentation {:.2} s{}, refinement {:.2} s{}, write {:.2} s, total {:.2} s",
-        loaded.read_time.as_secs_f64(),
-        loaded.shape_time.as_secs_f64(),
+        outcome.load_times.0.as_secs_f64(),
+        outcome.load_times.1.as_secs_f64(),
         match times.features {
             Some(t) => format!("feature choice {:.2} s, ", t.as_secs_f64()),
             None => String::new(),
@@ -342,13 +270,13 @@ fn report(
             ),
             _ => String::new(),
         },
-        write_time.as_secs_f64(),
+        outcome.write_time.as_secs_f64(),
         t0.elapsed().as_secs_f64()
     );
-    if !loaded.skipped.is_empty() {
+    if !outcome.skipped.is_empty() {
         println!(
             "skipped {} of {total_files} files (listed above and in summary.json)",
-            loaded.skipped.len()
+            outcome.skipped.len()
         );
     }
     let out = args.out.display();
@@ -358,5 +286,27 @@ fn report(
         println!(
             "results: {out}/summary.json; pictures: {out}/preview.png; viewer: {out}/index.html"
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    #[derive(Parser)]
+    struct Cli {
+        #[command(flatten)]
+        args: SegmentArgs,
+    }
+
+    /// The bare command runs the job's default: the CLI chooses no default of its own.
+    #[test]
+    fn the_bare_command_runs_the_default_job() {
+        let cli = Cli::parse_from(["coseg", "shapes", "-o", "out"]);
+        let mut want = SegmentJob::default();
+        want.output = Some(PathBuf::from("out"));
+        want.pictures = true;
+        assert_eq!(segment_job(&cli.args).unwrap(), want);
     }
 }

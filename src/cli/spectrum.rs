@@ -36,8 +36,8 @@ pub struct SpectrumArgs {
     #[arg(long)]
     basis_size: Option<usize>,
     /// Triangulation of the Laplacian: cotan (the mesh's triangles) or intrinsic-delaunay.
-    #[arg(long, default_value = "cotan")]
-    laplacian: String,
+    #[arg(long, default_value_t = SpectrumOptions::default().laplacian)]
+    laplacian: coseg::spectral::LaplacianKind,
     /// Print solver statistics (timings, factor size) to stderr.
     #[arg(long)]
     stats: bool,
@@ -54,7 +54,7 @@ pub fn run(args: SpectrumArgs) -> Result<ExitCode> {
         opts.seed = args.seed;
         opts.threads = args.solver_threads;
         opts.basis_size = args.basis_size;
-        opts.laplacian = args.laplacian.parse().map_err(anyhow::Error::msg)?;
+        opts.laplacian = args.laplacian;
         opts
     };
     let pipeline = {

@@ -34,8 +34,8 @@ pub struct StudioArgs {
     #[arg(long)]
     labels: Option<PathBuf>,
     /// Port on 127.0.0.1 (default 0: any free port; the address is printed).
-    #[arg(long, default_value_t = 0)]
-    port: u16,
+    #[arg(long)]
+    port: Option<u16>,
     /// Open the address in the system's browser.
     #[arg(long)]
     open: bool,
@@ -84,8 +84,10 @@ pub fn run(args: StudioArgs) -> Result<ExitCode> {
         super::warn(w);
     }
     // Loopback only: another machine cannot reach the server at all.
-    let server = Server::http(("127.0.0.1", args.port))
-        .map_err(|e| anyhow::anyhow!("cannot listen on 127.0.0.1:{}: {e}", args.port))?;
+    // No port: 0, the operating system's "any free port".
+    let server = Server::http(("127.0.0.1", args.port.unwrap_or(0))).map_err(|e| {
+        anyhow::anyhow!("cannot listen on 127.0.0.1:{}: {e}", args.port.unwrap_or(0))
+    })?;
     let port = server
         .server_addr()
         .to_ip()

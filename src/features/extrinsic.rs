@@ -36,6 +36,25 @@ impl std::str::FromStr for Axis {
     }
 }
 
+/// The form `coseg --up` takes: `x`, `-y`, … (`+` unwritten).
+impl std::fmt::Display for Axis {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let sign = if self.positive { "" } else { "-" };
+        let name = ["x", "y", "z"].get(self.index).copied().unwrap_or("?");
+        write!(f, "{sign}{name}")
+    }
+}
+
+/// The form `coseg --up` takes: an axis (`y`, `-z`) or `pca`.
+impl std::fmt::Display for Alignment {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Alignment::Up(a) => a.fmt(f),
+            Alignment::Pca => f.write_str("pca"),
+        }
+    }
+}
+
 /// How a shape is put in the frame its extrinsic features are measured in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Alignment {

@@ -9,7 +9,11 @@
 //!   annotation each, [`JobLabels`]);
 //! - [`run_eval`]`(result, truth, &`[`EvalJob`]`) -> Result<`[`FolderScores`](crate::evaluate::FolderScores)`, `[`JobError`]`>`:
 //!   `coseg eval`;
-//! - [`align_folder`](crate::align::align_folder) (`coseg align`) lives with its stage.
+//! - [`run_align`]`(folder, &`[`AlignJob`]`) -> Result<`[`AlignOutcome`]`, `[`JobError`]`>`:
+//!   `coseg align`;
+//! - [`run_segment`]`(`[`SegmentInput`]`, &`[`SegmentJob`]`) -> Result<`[`SegmentOutcome`]`, `[`JobError`]`>`:
+//!   `coseg segment` and `coseg.segment`;
+//! - [`defaults`]: every job's default by keyword, as the front ends name their options.
 //!
 //! Each job's options struct is `#[non_exhaustive]`, and its `Default` is the command's
 //! default: `coseg pair A B -o OUT` with no other flag runs `PairJob { output: Some(OUT),
@@ -18,18 +22,30 @@
 //! ([`load_shape`](crate::pipeline::load_shape),
 //! [`load_shape_from_mesh`](crate::pipeline::load_shape_from_mesh)) with the same warnings.
 
+mod align_job;
+mod defaults;
 mod eval_job;
 mod pair_job;
 mod propagate_job;
+mod segment_job;
 
+pub use align_job::{AlignJob, AlignOutcome, run_align};
+pub use defaults::defaults;
 pub use eval_job::{EvalJob, run_eval};
 pub use pair_job::{PairJob, PairOutcome, run_pair};
 pub use propagate_job::{
     ARRAY_SOURCE, JobLabels, PropagateInput, PropagateJob, PropagateOutcome, run_propagate,
 };
+pub use segment_job::{
+    SegmentInput, SegmentJob, SegmentOutcome, SegmentProgress, run_segment,
+    run_segment_with_progress,
+};
 
+use crate::cache::CacheOutcome;
+use crate::graph::ShapeNode;
 use crate::mesh::TriMesh;
-use crate::pipeline::{LoadedShape, PipelineError, ShapeContent, ShapePipelineOptions};
+use crate::pipeline::{LoadedShape, PipelineError, ShapeBands, ShapeContent, ShapePipelineOptions};
+use rayon::prelude::*;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
@@ -64,6 +80,17 @@ pub enum JobError {
     /// Writing the outputs failed.
     #[error(transparent)]
     Output(#[from] crate::output::OutputError),
+    /// The alignment failed, or its files could not be read or written (the message names
+    /// the file).
+    #[error(transparent)]
+    Align(#[from] crate::align::AlignError),
+    /// The co-segmentation failed or refused its options.
+    #[error(transparent)]
+    Graph(#[from] crate::graph::GraphError),
+    /// Input files could not be used, and the job was asked to fail rather than skip them
+    /// ([`SegmentJob::strict`]).
+    #[error("{} input file(s) could not be used: {}", .0.len(), .0.iter().map(|s| s.error.as_str()).collect::<Vec<_>>().join("; "))]
+    Skipped(Vec<crate::output::SkippedInput>),
     /// Invalid inputs or options (e.g. two shapes with one name).
     #[error("{0}")]
     Invalid(String),
@@ -173,4 +200,78 @@ impl CacheChoice {
             CacheChoice::Off => None,
         }
     }
+}
+
+/// Shapes through the per-shape stage: their meshes and graph nodes, where each shape's data
+/// came from, and the warnings (the meshes', the cache's).
+struct LoadedNodes {
+    meshes: Vec<TriMesh>,
+    nodes: Vec<ShapeNode>,
+    outcomes: Vec<Option<CacheOutcome>>,
+    warnings: Vec<String>,
+}
+
+/// Every shape read and through the per-shape stage side by side (through `cache` when given);
+/// the first error, naming its shape, stops the job.
+fn load_nodes(
+    shapes: Vec<JobShape>,
+    pipeline: &ShapePipelineOptions,
+    cache: Option<&Path>,
+) -> Result<LoadedNodes, JobError> {
+    let read: Vec<_> = shapes.into_par_iter().map(JobShape::read).collect();
+    let mut warnings = Vec::new();
+    let mut meshes = Vec::with_capacity(read.len());
+    for r in read {
+        let (name, file, mesh, w) = r?;
+        warnings.extend(w);
+        meshes.push((name, file, mesh));
+    }
+    let mut loaded = load_read(meshes, pipeline, cache)?;
+    warnings.append(&mut loaded.warnings);
+    loaded.warnings = warnings;
+    Ok(loaded)
+}
+
+/// Shapes already read ([`JobShape::read`]: name, file, mesh) through the per-shape stage side
+/// by side (through `cache` when given).
+fn load_read(
+    shapes: Vec<(String, Option<PathBuf>, TriMesh)>,
+    pipeline: &ShapePipelineOptions,
+    cache: Option<&Path>,
+) -> Result<LoadedNodes, JobError> {
+    let names: Vec<(String, String)> = shapes
+        .iter()
+        .map(|(name, file, _)| {
+            let file = file
+                .as_ref()
+                .map_or_else(|| name.clone(), |f| f.display().to_string());
+            (name.clone(), file)
+        })
+        .collect();
+    let loaded: Vec<_> = shapes
+        .into_par_iter()
+        .map(|(name, file, mesh)| {
+            JobShape::Mesh { name, file, mesh }.load::<ShapeBands>(pipeline, cache)
+        })
+        .collect();
+    let mut out = LoadedNodes {
+        meshes: Vec::with_capacity(loaded.len()),
+        nodes: Vec::with_capacity(loaded.len()),
+        outcomes: Vec::with_capacity(loaded.len()),
+        warnings: Vec::new(),
+    };
+    for (l, (name, file)) in loaded.into_iter().zip(names) {
+        let l = l?;
+        out.warnings.extend(l.warnings);
+        out.outcomes.push(l.outcome);
+        let node = ShapeNode::new(name, l.data.bands, &l.data.vertex_areas).map_err(|e| {
+            JobError::Stage {
+                context: file,
+                source: Box::new(e),
+            }
+        })?;
+        out.nodes.push(node);
+        out.meshes.push(l.mesh);
+    }
+    Ok(out)
 }

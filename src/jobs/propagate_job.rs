@@ -3,11 +3,9 @@
 
 use super::{CacheChoice, JobError, JobShape};
 use crate::cache::CacheOutcome;
-use crate::graph::ShapeNode;
 use crate::labels::{LabelKind, PartNames, read_part_names, read_shape_labels};
 use crate::mesh::TriMesh;
 use crate::output::{PropagationSummary, write_propagation, write_visuals};
-use crate::pipeline::ShapeBands;
 use crate::propagate::{
     PropagateCollectionOptions, PropagateError, PropagatedCollection, SourceFile,
     propagate_collection, propagate_loaded,
@@ -211,33 +209,10 @@ fn propagate_shapes(
             source: Box::new(PropagateError::NoLabels),
         });
     }
-    let loaded: Vec<_> = shapes
-        .into_par_iter()
-        .map(|(name, file, mesh)| {
-            JobShape::Mesh { name, file, mesh }.load::<ShapeBands>(&options.pipeline, cache)
-        })
-        .collect();
-    let mut meshes = Vec::with_capacity(loaded.len());
-    let mut nodes = Vec::with_capacity(loaded.len());
-    let mut outcomes = Vec::with_capacity(loaded.len());
-    let mut bands = Vec::with_capacity(loaded.len());
-    for l in loaded {
-        let l = l?;
-        warnings.extend(l.warnings);
-        outcomes.push(l.outcome);
-        bands.push(l.data);
-        meshes.push(l.mesh);
-    }
+    let loaded = super::load_read(shapes, &options.pipeline, cache)?;
+    warnings.extend(loaded.warnings);
     warnings.extend(w);
-    for ((name, b), file) in names.iter().zip(bands).zip(&files) {
-        let node = ShapeNode::new(name.clone(), b.bands, &b.vertex_areas).map_err(|e| {
-            JobError::Stage {
-                context: file.clone(),
-                source: Box::new(e),
-            }
-        })?;
-        nodes.push(node);
-    }
+    let (meshes, nodes, outcomes) = (loaded.meshes, loaded.nodes, loaded.outcomes);
     let solved =
         propagate_loaded(nodes, &meshes, &annotations, options).map_err(|e| JobError::Stage {
             context: "propagating labels".into(),

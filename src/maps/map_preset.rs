@@ -191,6 +191,20 @@ pub struct ResolvedMapStep {
 }
 
 impl MapStep {
+    /// The map step with `preset` (`None`: [`MapStep::Auto`], the preset picked from the two
+    /// spectra) and `overrides`, as `coseg pair --map-preset` and the overriding flags state it.
+    ///
+    /// ```
+    /// use coseg::maps::{MapOverrides, MapStep};
+    /// assert_eq!(MapStep::with_preset(None, MapOverrides::default()), MapStep::default());
+    /// ```
+    pub fn with_preset(preset: Option<MapPreset>, overrides: MapOverrides) -> Self {
+        match preset {
+            None => MapStep::Auto(overrides),
+            Some(p) => MapStep::Preset(p, overrides),
+        }
+    }
+
     /// The options for shapes with spectra `a` and `b`. The discrepancy is computed for
     /// [`MapStep::Auto`] and [`MapStep::Preset`] (reported with the preset used), and errors
     /// only there.

@@ -34,40 +34,39 @@ pub struct ChooseFeaturesOptions {
     /// [`AlignOptions::default`]).
     pub align: AlignOptions,
     /// The extrinsic family's columns (default: [`ExtrinsicOptions::default`]'s 100 height
-    /// directions and two distances, with [`ChooseFeaturesOptions::DEFAULT_NORMALS`] normal
+    /// directions and two distances, with 16 normal
     /// columns); its `alignment` is ignored (the frame is the collection's).
     pub extrinsic: ExtrinsicOptions,
     /// How the extrinsic columns are cut into bands (default [`BandWeighting::Count`], as the
     /// per-shape pipeline's default; the band count is the nodes').
     pub weighting: BandWeighting,
     /// Equal-area regions of the probe co-segmentation each candidate is scored on (default
-    /// [`ChooseFeaturesOptions::DEFAULT_PROBE_REGIONS`]).
+    /// 12, the leaves of the default parts).
     pub probe_regions: usize,
 }
 
-impl ChooseFeaturesOptions {
-    /// Normal columns `|n · u|` of the chosen extrinsic family: 16 directions, the count the
-    /// aligned figures of docs/FEATURES.md and docs/PARTS.md were measured with (they tell a
-    /// seat from a back at the same height).
-    pub const DEFAULT_NORMALS: usize = 16;
+/// Normal columns `|n · u|` of the chosen extrinsic family (a heuristic, hence private; the
+/// default reaches callers through [`ChooseFeaturesOptions::default`]): 16 directions, the
+/// count the aligned figures of docs/FEATURES.md and docs/PARTS.md were measured with (they
+/// tell a seat from a back at the same height).
+const DEFAULT_NORMALS: usize = 16;
 
-    /// Regions of the probe: 12, the finest parts of the default mode (as many as the
-    /// equal-area leaves of parts from geometry, `PartsFrom::GEOMETRY_LEAVES`; a test keeps
-    /// the two equal), so each candidate is scored on the regions the parts are grouped from.
-    pub const DEFAULT_PROBE_REGIONS: usize = 12;
-}
+/// Regions of the probe: the finest parts of the default mode (the equal-area leaves of parts
+/// from geometry; a test keeps the two equal), so each candidate is scored on the regions the
+/// parts are grouped from.
+const DEFAULT_PROBE_REGIONS: usize = 12;
 
 impl Default for ChooseFeaturesOptions {
     fn default() -> Self {
         let extrinsic = ExtrinsicOptions {
-            normal_directions: Self::DEFAULT_NORMALS,
+            normal_directions: DEFAULT_NORMALS,
             ..ExtrinsicOptions::default()
         };
         Self {
             align: AlignOptions::default(),
             extrinsic,
             weighting: BandWeighting::Count,
-            probe_regions: Self::DEFAULT_PROBE_REGIONS,
+            probe_regions: DEFAULT_PROBE_REGIONS,
         }
     }
 }

@@ -33,7 +33,7 @@ pub struct SegmentCollectionOptions {
     /// The co-segmentation (default: [`CosegmentOptions::default`]).
     pub cosegment: CosegmentOptions,
     /// Boundary refinement after the co-segmentation; `None` keeps the raw region tuples.
-    /// Default: [`SegmentCollectionOptions::DEFAULT_REFINE`].
+    /// Default: 30 sweeps at smoothing time `3e-3` (more than a pair's 10: see `DEFAULT_REFINE`).
     pub refine: Option<RefineOptions>,
     /// Per-feature affinity weights on every edge (`None`: equal weights), e.g. the feature
     /// families' weights ([`crate::pipeline::ShapePipelineOptions::feature_weights`]).
@@ -139,26 +139,38 @@ pub enum PartsFrom {
     /// least weight, concave creases being cheap.
     Geometry {
         /// Number of equal-area regions (the finest parts; `coseg segment --regions`,
-        /// default [`PartsFrom::GEOMETRY_LEAVES`]).
+        /// default 12).
         leaves: usize,
         /// How far a part boundary may move, × √(shape area) (`coseg segment --snap-band`,
-        /// default [`PartsFrom::GEOMETRY_BAND`]); 0 keeps the regions' boundaries.
+        /// default 0.1); 0 keeps the regions' boundaries.
         band: f64,
     },
 }
 
+/// The default number of leaves of [`PartsFrom::Geometry`] (a heuristic, hence private: the
+/// default reaches callers through [`SegmentCollectionOptions::default`]): enough that each
+/// region lies mostly in one part of a body or a chair (measured: 84–92 % of their area on the
+/// generated families), few enough that each is a sizeable piece of a part.
+pub(crate) const GEOMETRY_LEAVES: usize = 12;
+
+/// The default band of [`PartsFrom::Geometry`], × √(shape area) (a heuristic, private like
+/// [`GEOMETRY_LEAVES`]): about a third of the radius of a disc of one leaf's area (1/12 of the
+/// shape). Measured on the 36 generated sets of seeds 1–9 (docs/PARTS.md, "Boundaries snapped
+/// to creases"): 0.06 and 0.1 lift the sets meeting the bar from 15 to 23 and 24, 0.15 moves
+/// boundaries too far.
+pub(crate) const GEOMETRY_BAND: f64 = 0.1;
+
+/// The collection's default refinement (a heuristic, private: callers read it from
+/// [`SegmentCollectionOptions::default`]): 30 sweeps at smoothing time `3e-3`. More sweeps
+/// than a pair's default (10) because a sweep over a collection moves each boundary by about
+/// one smoothing length, and the measured agreement with the ground truth keeps rising to about
+/// 30 sweeps (8 TOSCA cats, 6 regions: 88.8 % at 10, 90.8 % at 30; docs/RESULTS.md).
+const DEFAULT_REFINE: RefineOptions = RefineOptions {
+    max_rounds: 30,
+    smoothing_time: 3e-3,
+};
+
 impl PartsFrom {
-    /// The default number of leaves of [`PartsFrom::Geometry`]: enough that each region lies
-    /// mostly in one part of a body or a chair (measured: 84–92 % of their area on the
-    /// generated families), few enough that each is a sizeable piece of a part.
-    pub const GEOMETRY_LEAVES: usize = 12;
-
-    /// The default band of [`PartsFrom::Geometry`], × √(shape area): about a third of the
-    /// radius of a disc of one leaf's area (1/12 of the shape). Measured on the 36 generated
-    /// sets of seeds 1–9 (docs/PARTS.md, "Boundaries snapped to creases"): 0.06 and 0.1 lift
-    /// the sets meeting the bar from 15 to 23 and 24, 0.15 moves boundaries too far.
-    pub const GEOMETRY_BAND: f64 = 0.1;
-
     fn is_adaptive(&self) -> bool {
         *self == Self::Adaptive
     }
@@ -167,8 +179,8 @@ impl PartsFrom {
 impl std::str::FromStr for PartsFrom {
     type Err = GraphError;
 
-    /// `adaptive` or `geometry` (with [`PartsFrom::GEOMETRY_LEAVES`] leaves and
-    /// [`PartsFrom::GEOMETRY_BAND`]).
+    /// `adaptive` or `geometry` (12 leaves, band 0.1: the
+    /// defaults of [`SegmentCollectionOptions::default`]).
     ///
     /// ```
     /// use coseg::parts::PartsFrom;
@@ -179,8 +191,8 @@ impl std::str::FromStr for PartsFrom {
         match s {
             "adaptive" => Ok(Self::Adaptive),
             "geometry" => Ok(Self::Geometry {
-                leaves: Self::GEOMETRY_LEAVES,
-                band: Self::GEOMETRY_BAND,
+                leaves: GEOMETRY_LEAVES,
+                band: GEOMETRY_BAND,
             }),
             _ => Err(GraphError::BadOption(format!(
                 "{s:?}: expected `adaptive` or `geometry`"
@@ -231,18 +243,6 @@ fn is_free(r: &RefineSizes) -> bool {
 
 fn is_one(n: &usize) -> bool {
     *n == 1
-}
-
-impl SegmentCollectionOptions {
-    /// The collection's default refinement: 30 sweeps at smoothing time `3e-3`. More sweeps
-    /// than a pair's default (10) because a sweep over a collection moves each boundary by
-    /// about one smoothing length, and the measured agreement with the ground truth keeps
-    /// rising to about 30 sweeps (8 TOSCA cats, 6 regions: 88.8 % at 10, 90.8 % at 30; see the
-    /// README).
-    pub const DEFAULT_REFINE: RefineOptions = RefineOptions {
-        max_rounds: 30,
-        smoothing_time: 3e-3,
-    };
 }
 
 /// How many parts of their own size to ask for (`coseg segment --parts auto|N`).
@@ -445,8 +445,8 @@ impl Default for SegmentCollectionOptions {
         Self {
             parts: Some(AdaptiveOptions::default()),
             parts_from: PartsFrom::Geometry {
-                leaves: PartsFrom::GEOMETRY_LEAVES,
-                band: PartsFrom::GEOMETRY_BAND,
+                leaves: GEOMETRY_LEAVES,
+                band: GEOMETRY_BAND,
             },
             ..Self::equal_areas(CosegmentOptions::default().regions)
         }
@@ -472,7 +472,7 @@ impl SegmentCollectionOptions {
         Self {
             graph: GraphOptions::default(),
             cosegment,
-            refine: Some(Self::DEFAULT_REFINE),
+            refine: Some(DEFAULT_REFINE),
             feature_weights: None,
             parts: None,
             starts: 1,

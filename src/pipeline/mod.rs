@@ -38,7 +38,8 @@ pub use load_shape::{
     load_shape, load_shape_from_mesh,
 };
 pub use shape_data::{
-    PipelineError, ShapeBands, ShapeData, ShapePipelineOptions, StoredShape, compute_shape_data,
-    decode_bands_entry, decode_shape_entry, encode_bands_entry, encode_shape_entry,
-    shape_data_from_spectrum, shape_key, small_mesh_warning, unresolved_triangles_warning,
+    FamilyFlags, PipelineError, ShapeBands, ShapeData, ShapePipelineOptions, StoredShape,
+    compute_shape_data, decode_bands_entry, decode_shape_entry, encode_bands_entry,
+    encode_shape_entry, shape_data_from_spectrum, shape_key, small_mesh_warning,
+    unresolved_triangles_warning,
 };

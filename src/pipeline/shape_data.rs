@@ -53,7 +53,57 @@ pub struct ShapePipelineOptions {
     pub families: FeatureFamilies,
 }
 
+/// The feature families in their text form, as `coseg`'s flags and the Python package's
+/// keywords state them; `Default` is their default (the spectral family, `--up y`, the
+/// extrinsic family's default directions, no normal columns, weights 1 each), the one place
+/// the front ends take it from. Applied by [`ShapePipelineOptions::set_family_flags`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+#[non_exhaustive]
+pub struct FamilyFlags {
+    /// `--features`: `spectral,extrinsic,sdf,user:DIR`.
+    pub features: String,
+    /// `--up`: `y`, `-z`, `pca`, ….
+    pub up: String,
+    /// `--directions`: the extrinsic family's height directions.
+    pub directions: usize,
+    /// `--normals`: the extrinsic family's normal columns.
+    pub normals: usize,
+    /// `--family-weights`: `extrinsic=2,sdf=0.5` (empty: 1 each).
+    pub family_weights: String,
+}
+
+impl Default for FamilyFlags {
+    fn default() -> Self {
+        let extrinsic = crate::features::ExtrinsicOptions::default();
+        Self {
+            features: "spectral".into(),
+            up: extrinsic.alignment.to_string(),
+            directions: extrinsic.directions,
+            normals: extrinsic.normal_directions,
+            family_weights: String::new(),
+        }
+    }
+}
+
 impl ShapePipelineOptions {
+    /// [`Self::set_families`] from [`FamilyFlags`].
+    ///
+    /// ```
+    /// use coseg::pipeline::{FamilyFlags, ShapePipelineOptions};
+    /// let mut o = ShapePipelineOptions::default();
+    /// o.set_family_flags(&FamilyFlags::default()).unwrap();
+    /// assert_eq!(o, ShapePipelineOptions::default());
+    /// ```
+    pub fn set_family_flags(&mut self, flags: &FamilyFlags) -> Result<(), FeatureError> {
+        self.set_families(
+            &flags.features,
+            &flags.up,
+            flags.directions,
+            flags.normals,
+            &flags.family_weights,
+        )
+    }
+
     /// Sets the feature families from their text form, as `coseg`'s flags state them:
     /// `features` = `--features` (`spectral,extrinsic,sdf,user:DIR`,
     /// [`parse_families`](crate::features::parse_families)), `up` = `--up` (`y`, `-z`, `pca`,

@@ -27,7 +27,7 @@ pub struct RouteOptions {
     /// sources by a similarity, labels from the nearest surface point. Default `true`.
     pub rigid: bool,
     /// How far the fused labels' boundaries may move onto a concave crease, × √(shape area)
-    /// ([`super::snap_labels`]; [`PartsFrom::GEOMETRY_BAND`], 0.1, is the parts' own band).
+    /// ([`super::snap_labels`]; 0.1, the band of parts from geometry, is the parts' own band).
     /// Default `0`: the boundaries stay where the votes cross. The minimum cut moves a
     /// boundary wherever a crease-free surface offers a shorter cut (permuted copies of a
     /// smooth blob: 98.1 % fused, 74.7 % snapped; tests/propagate_fusion.rs), so it is
@@ -122,8 +122,8 @@ impl CollectionParts {
             o.request_parts(PartsRequest::Count(count), None);
             o.set_parts_from(
                 PartsFrom::Geometry {
-                    leaves: PartsFrom::GEOMETRY_LEAVES.max(count),
-                    band: PartsFrom::GEOMETRY_BAND,
+                    leaves: crate::parts::GEOMETRY_LEAVES.max(count),
+                    band: crate::parts::GEOMETRY_BAND,
                 },
                 None,
             );

@@ -28,6 +28,16 @@ impl LaplacianKind {
     }
 }
 
+/// The name `coseg --laplacian` takes (`cotan`, `intrinsic-delaunay`).
+impl std::fmt::Display for LaplacianKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            LaplacianKind::Cotangent => "cotan",
+            LaplacianKind::IntrinsicDelaunay => "intrinsic-delaunay",
+        })
+    }
+}
+
 impl std::str::FromStr for LaplacianKind {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, Self::Err> {

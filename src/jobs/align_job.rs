@@ -1,30 +1,35 @@
-//! [`align_folder`]: `coseg align FOLDER -o OUT` as a library job — every mesh of a folder put
+//! [`run_align`]: `coseg align FOLDER -o OUT` as a library call — every mesh of a folder put
 //! in one collection frame, `transforms.json` written atomically (and the aligned meshes on
 //! request).
 
-use super::AlignError;
-use super::align_collection::{AlignOptions, CollectionAlignment, align_collection};
+use super::JobError;
+use crate::align::{AlignError, AlignOptions, CollectionAlignment, align_collection};
 use crate::mesh::{TriMesh, read_mesh, write_atomic, write_mesh};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
-/// Options of [`align_folder`].
+/// Options of [`run_align`]; `Default` is `coseg align`'s default.
 #[derive(Debug, Clone, PartialEq, Default)]
 #[non_exhaustive]
-pub struct AlignFolderOptions {
+pub struct AlignJob {
     /// The alignment itself (default [`AlignOptions::default`]).
     pub align: AlignOptions,
-    /// Also write every mesh in the collection frame as `OUT/<file name>` (default false;
+    /// Also write every mesh in the collection frame as `<output>/<file name>` (default false;
     /// `--write-meshes`). A mesh whose transform is the identity (the already-aligned case) is
     /// copied byte for byte.
     pub write_meshes: bool,
+    /// Folder for `transforms.json` (and the meshes), created if missing; it must differ from
+    /// the input folder, so that a run never reads its own outputs. `None` (default): nothing
+    /// is written.
+    pub output: Option<PathBuf>,
 }
 
-/// What [`align_folder`] found and wrote.
+/// What [`run_align`] found and wrote.
 #[derive(Debug, Clone, PartialEq)]
-pub struct AlignFolderReport {
-    /// The mesh files, in the order of [`AlignFolderReport::alignment`]'s shapes.
+#[non_exhaustive]
+pub struct AlignOutcome {
+    /// The mesh files, in the order of [`AlignOutcome::alignment`]'s shapes.
     pub files: Vec<PathBuf>,
     /// The alignment.
     pub alignment: CollectionAlignment,
@@ -35,7 +40,7 @@ pub struct AlignFolderReport {
 #[derive(Serialize)]
 struct TransformsFile<'a> {
     format: u32,
-    case: super::FrameCase,
+    case: crate::align::FrameCase,
     up: [f64; 3],
     forward: [f64; 3],
     given_frame_share: f64,
@@ -49,26 +54,26 @@ struct ShapeEntry<'a> {
     name: String,
     file: String,
     #[serde(flatten)]
-    alignment: &'a super::ShapeAlignment,
+    alignment: &'a crate::align::ShapeAlignment,
 }
 
-/// Aligns every mesh of `folder` (`.obj`, `.off`, `.ply`, sorted by name) and writes
-/// `out/transforms.json` (format in docs/ALIGN.md), plus the aligned meshes with
-/// [`AlignFolderOptions::write_meshes`].
+/// Aligns every mesh of `folder` (`.obj`, `.off`, `.ply`, sorted by name) and, with an output
+/// folder, writes `transforms.json` (format in docs/ALIGN.md), plus the aligned meshes with
+/// [`AlignJob::write_meshes`].
 ///
-/// - `folder`: the collection; `out`: the output folder (created; must differ from `folder`,
-///   so that a run never reads its own outputs);
-/// - returns an [`AlignFolderReport`].
+/// - `folder`: the collection;
+/// - returns an [`AlignOutcome`].
 ///
-/// Errors: [`AlignError::Io`] / [`AlignError::Mesh`] naming the file; [`AlignError::BadOption`]
-/// when `out` is `folder` or the folder holds no mesh; the alignment's errors, naming the file.
+/// Errors: [`JobError::Align`]: [`AlignError::Io`] / [`AlignError::Mesh`] naming the file,
+/// [`AlignError::BadOption`] when the output is `folder` or the folder holds no mesh, the
+/// alignment's errors naming the file.
 ///
-/// See also: [`align_collection`].
-pub fn align_folder(
-    folder: &Path,
-    out: &Path,
-    options: &AlignFolderOptions,
-) -> Result<AlignFolderReport, AlignError> {
+/// See also: [`align_collection`], the stage alone.
+pub fn run_align(folder: &Path, job: &AlignJob) -> Result<AlignOutcome, JobError> {
+    Ok(align_folder(folder, job)?)
+}
+
+fn align_folder(folder: &Path, job: &AlignJob) -> Result<AlignOutcome, AlignError> {
     let files = mesh_files(folder)?;
     if files.is_empty() {
         return Err(AlignError::BadOption(format!(
@@ -76,16 +81,18 @@ pub fn align_folder(
             folder.display()
         )));
     }
-    std::fs::create_dir_all(out).map_err(|source| AlignError::Io {
-        path: out.display().to_string(),
-        source,
-    })?;
-    let same = |a: &Path, b: &Path| matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
-    if same(folder, out) {
-        return Err(AlignError::BadOption(format!(
-            "{}: the output folder must differ from the input folder",
-            out.display()
-        )));
+    if let Some(out) = &job.output {
+        std::fs::create_dir_all(out).map_err(|source| AlignError::Io {
+            path: out.display().to_string(),
+            source,
+        })?;
+        let same = |a: &Path, b: &Path| matches!((a.canonicalize(), b.canonicalize()), (Ok(x), Ok(y)) if x == y);
+        if same(folder, out) {
+            return Err(AlignError::BadOption(format!(
+                "{}: the output folder must differ from the input folder",
+                out.display()
+            )));
+        }
     }
     let meshes: Vec<TriMesh> = files
         .par_iter()
@@ -96,7 +103,7 @@ pub fn align_folder(
             })
         })
         .collect::<Result<_, _>>()?;
-    let alignment = align_collection(&meshes, &options.align).map_err(|e| match e {
+    let alignment = align_collection(&meshes, &job.align).map_err(|e| match e {
         AlignError::Degenerate(m) => AlignError::Degenerate(name_shape(&m, &files)),
         e => e,
     })?;
@@ -126,6 +133,13 @@ pub fn align_folder(
             .collect(),
         edges: &alignment.edges,
     };
+    let Some(out) = &job.output else {
+        return Ok(AlignOutcome {
+            files,
+            alignment,
+            written: Vec::new(),
+        });
+    };
     let json = serde_json::to_vec_pretty(&doc).expect("plain data serialises");
     let path = out.join("transforms.json");
     write_atomic(&path, |w| std::io::Write::write_all(w, &json)).map_err(|source| {
@@ -135,7 +149,7 @@ pub fn align_folder(
         }
     })?;
     let mut written = vec![path];
-    if options.write_meshes {
+    if job.write_meshes {
         for ((f, m), s) in files.iter().zip(&meshes).zip(&alignment.shapes) {
             let p = out.join(name(f));
             if s.transform.is_identity() {
@@ -165,7 +179,7 @@ pub fn align_folder(
             written.push(p);
         }
     }
-    Ok(AlignFolderReport {
+    Ok(AlignOutcome {
         files,
         alignment,
         written,
