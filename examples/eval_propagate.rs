@@ -219,6 +219,9 @@ fn run(
             eprintln!("{line}");
         }
     }
+    if let Some(dir) = std::env::var_os("COSEG_DUMP") {
+        dump_run(set, std::path::Path::new(&dir), sources, annotation, score, &report, &p)?;
+    }
     let mut log = set.route_log.lock().unwrap();
     for (route, labels) in &report.routes {
         let r: Vec<(usize, f64)> = targets
@@ -245,6 +248,77 @@ fn run(
         .or_default()
         .push((sources[0], mean(&r)));
     Ok(r)
+}
+
+/// `COSEG_DUMP=DIR`: writes every route's labels and confidences on every target, the
+/// held-out runs and the scores to `DIR/run-<sources>.json` (and the shapes' areas and
+/// per-vertex ground truth to `DIR/shapes.json` once), for studying fusion rules offline.
+fn dump_run(
+    set: &Set,
+    dir: &std::path::Path,
+    sources: &[usize],
+    annotation: &dyn Fn(usize) -> Vec<i32>,
+    score: &dyn Fn(usize, &[i32]) -> f64,
+    report: &coseg::propagate::FusionReport,
+    p: &coseg::propagate::Propagation,
+) -> Result<(), Box<dyn std::error::Error>> {
+    use serde_json::json;
+    std::fs::create_dir_all(dir)?;
+    let shapes = dir.join("shapes.json");
+    if !shapes.exists() {
+        let v: Vec<_> = (0..set.names.len())
+            .map(|i| {
+                json!({"name": set.names[i], "areas": set.graph.node(i).areas, "gt": annotation(i)})
+            })
+            .collect();
+        std::fs::write(&shapes, serde_json::to_string(&v)?)?;
+    }
+    let r3 = |c: &[f64]| -> Vec<f64> { c.iter().map(|x| (x * 1000.0).round() / 1000.0).collect() };
+    let n = set.names.len();
+    let targets: Vec<_> = (0..n)
+        .filter(|i| !sources.contains(i))
+        .map(|i| {
+            let routes: serde_json::Map<String, serde_json::Value> = report
+                .routes
+                .iter()
+                .map(|(r, l)| {
+                    (
+                        r.name().to_string(),
+                        json!({
+                            "labels": l.labels[i],
+                            "conf": r3(&l.confidence[i]),
+                            "shape_conf": l.shape_confidence[i],
+                            "residual": if l.residual[i].is_finite() { l.residual[i] } else { -1.0 },
+                            "score": if l.votes_on(i) { score(i, &l.labels[i]) } else { -1.0 },
+                        }),
+                    )
+                })
+                .collect();
+            json!({
+                "shape": i,
+                "routes": routes,
+                "fused_score": score(i, &p.labels[i]),
+                "weights": report.fused.weights[i],
+            })
+        })
+        .collect();
+    let held = report.held_out_runs.as_ref().map(|h| {
+        json!({
+            "sources": h.sources,
+            "labels": h.labels,
+            "conf": h.confidence.iter().map(|c| c.iter().map(|x| r3(x)).collect::<Vec<_>>()).collect::<Vec<_>>(),
+            "scores": h.scores,
+            "residual": h.residual.iter().map(|r| r.iter().map(|x| if x.is_finite() { *x } else { -1.0 }).collect::<Vec<_>>()).collect::<Vec<_>>(),
+        })
+    });
+    let names: Vec<String> = report.routes.iter().map(|(r, _)| r.name().to_string()).collect();
+    let tag: Vec<String> = sources.iter().map(|s| s.to_string()).collect();
+    let v = json!({"sources": sources, "routes": names, "targets": targets, "held_out": held});
+    std::fs::write(
+        dir.join(format!("run-{}.json", tag.join("-"))),
+        serde_json::to_string(&v)?,
+    )?;
+    Ok(())
 }
 
 /// Prints each logged route's mean over the runs and its worst run, then clears the log.

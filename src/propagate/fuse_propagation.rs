@@ -2,7 +2,7 @@
 
 use super::{
     FusedRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
-    fuse_routes_with, held_out_accuracy, parts_route, rigid_route, snap_labels,
+    HeldOutRoutes, fuse_routes_with, held_out_routes, parts_route, rigid_route, snap_labels,
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
@@ -144,8 +144,11 @@ pub struct FusionReport {
     /// Optional routes that could not run, for the user.
     pub warnings: Vec<String>,
     /// Per route (the order of `routes`), its accuracy on the sources, each carried to from
-    /// the others ([`held_out_accuracy`]); `None` with fewer than two sources.
+    /// the others ([`super::held_out_accuracy`]); `None` with fewer than two sources.
     pub held_out: Option<Vec<f64>>,
+    /// The held-out runs themselves (each source's labels from every route); `None` with
+    /// fewer than two sources.
+    pub held_out_runs: Option<HeldOutRoutes>,
 }
 
 /// Fuses the band-affinity `propagation` with the other correspondence routes of `options`
@@ -155,7 +158,7 @@ pub struct FusionReport {
 /// [`Propagation::update`] continues from them.
 ///
 /// With two sources or more each route's trust is set by its accuracy on the sources
-/// themselves ([`held_out_accuracy`], [`fuse_routes_held_out`]): every source carried to from
+/// themselves ([`super::held_out_accuracy`], [`fuse_routes_with`]): every source carried to from
 /// the others by each route and scored against its own labels.
 ///
 /// Inputs: `graph`, `meshes` (#shapes, graph order), `annotations` (as given to
@@ -216,7 +219,7 @@ pub fn fuse_propagation(
         report.routes.push((Route::Rigid, rigid));
     }
     let names: Vec<Route> = report.routes.iter().map(|(r, _)| *r).collect();
-    report.held_out = held_out_accuracy(
+    report.held_out_runs = held_out_routes(
         graph,
         meshes,
         annotations,
@@ -226,6 +229,7 @@ pub fn fuse_propagation(
         segmentation,
         options.affine,
     )?;
+    report.held_out = report.held_out_runs.as_ref().map(|h| h.accuracy.clone());
     let refs: Vec<&RouteLabels> = report.routes.iter().map(|(_, r)| r).collect();
     // The two routes that read the intrinsic band features may fail together.
     let shared = names

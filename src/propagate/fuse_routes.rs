@@ -40,6 +40,10 @@ pub struct RouteLabels {
     /// Per shape: the route's own confidence on the shape, in `[0, 1]` (reported; the
     /// fusion's trust comes from agreement, [`FusedRoutes::weights`]).
     pub shape_confidence: Vec<f64>,
+    /// Per shape: how far the route's correspondence is from overlaying the shape on its
+    /// source, relative to the source's size (the rigid route: the symmetric trimmed chamfer
+    /// after registration, in source RMS radii); `NaN` where the route has no such measure.
+    pub residual: Vec<f64>,
 }
 
 impl RouteLabels {
@@ -49,6 +53,7 @@ impl RouteLabels {
             labels: vec![Vec::new(); n],
             confidence: vec![Vec::new(); n],
             shape_confidence: vec![0.0; n],
+            residual: vec![f64::NAN; n],
         }
     }
 

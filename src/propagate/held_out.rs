@@ -40,6 +40,52 @@ pub fn held_out_accuracy(
     segmentation: Option<&Cosegmentation>,
     affine: bool,
 ) -> Result<Option<Vec<f64>>, PropagateError> {
+    Ok(held_out_routes(
+        graph,
+        meshes,
+        annotations,
+        smoothers,
+        propagate,
+        routes,
+        segmentation,
+        affine,
+    )?
+    .map(|h| h.accuracy))
+}
+
+/// Every route's labels on every source, each carried to from the other sources, and the
+/// scores of [`held_out_accuracy`].
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct HeldOutRoutes {
+    /// The held-out sources (graph order), in the order of `labels` and `scores`.
+    pub sources: Vec<usize>,
+    /// Per held-out source, per route: the labels the route carried to it.
+    pub labels: Vec<Vec<Vec<i32>>>,
+    /// Per held-out source, per route: the route's confidences there (as in
+    /// [`super::RouteLabels::confidence`]).
+    pub confidence: Vec<Vec<Vec<f64>>>,
+    /// Per held-out source, per route: the route's residual there (as in
+    /// [`super::RouteLabels::residual`]; `NaN` where the route has none).
+    pub residual: Vec<Vec<f64>>,
+    /// Per held-out source, per route: the area share of its labels the route gave it.
+    pub scores: Vec<Vec<f64>>,
+    /// Per route: the mean of `scores` over the held-out sources.
+    pub accuracy: Vec<f64>,
+}
+
+/// [`held_out_accuracy`] with every held-out run's labels ([`HeldOutRoutes`]); same inputs
+/// and errors.
+#[allow(clippy::too_many_arguments)]
+pub fn held_out_routes(
+    graph: &ShapeGraph,
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    smoothers: Option<&[HeatSmoother]>,
+    propagate: &PropagateOptions,
+    routes: &[Route],
+    segmentation: Option<&Cosegmentation>,
+    affine: bool,
+) -> Result<Option<HeldOutRoutes>, PropagateError> {
     let n = annotations.len();
     let sources: Vec<usize> = (0..n)
         .filter(|&i| {
@@ -52,8 +98,7 @@ pub fn held_out_accuracy(
         return Ok(None);
     }
     let areas: Vec<&[f64]> = (0..n).map(|i| graph.node(i).areas.as_slice()).collect();
-    let mut sum = vec![0.0; routes.len()];
-    let mut count = 0usize;
+    let mut out = HeldOutRoutes::default();
     for &s in &sources {
         let mut ann = annotations.to_vec();
         let truth = ann[s].take().unwrap_or_default();
@@ -70,11 +115,14 @@ pub fn held_out_accuracy(
             if total > 0.0 { hit / total } else { 0.0 }
         };
         let mut scores = Vec::with_capacity(routes.len());
+        let mut labels = Vec::with_capacity(routes.len());
+        let mut confidence = Vec::with_capacity(routes.len());
+        let mut residual = Vec::with_capacity(routes.len());
         let mut skipped = false;
         for route in routes {
-            let labels: Vec<i32> = match route {
+            let (l, c, e): (Vec<i32>, Vec<f64>, f64) = match route {
                 Route::Affinity => match propagate_labels(graph, smoothers, &ann, propagate) {
-                    Ok(p) => p.labels[s].clone(),
+                    Ok(p) => (p.labels[s].clone(), p.confidence[s].clone(), f64::NAN),
                     Err(PropagateError::NoLabels) => {
                         skipped = true;
                         break;
@@ -82,20 +130,37 @@ pub fn held_out_accuracy(
                     Err(e) => return Err(e),
                 },
                 Route::Parts => match segmentation {
-                    Some(seg) => parts_route(seg, &ann, &areas).labels[s].clone(),
-                    None => Vec::new(),
+                    Some(seg) => {
+                        let r = parts_route(seg, &ann, &areas);
+                        (r.labels[s].clone(), r.confidence[s].clone(), f64::NAN)
+                    }
+                    None => (Vec::new(), Vec::new(), f64::NAN),
                 },
-                Route::Rigid => rigid_route_to(meshes, &ann, affine, &[s]).0.labels[s].clone(),
+                Route::Rigid => {
+                    let r = rigid_route_to(meshes, &ann, affine, &[s]).0;
+                    (r.labels[s].clone(), r.confidence[s].clone(), r.residual[s])
+                }
             };
-            scores.push(score(&labels));
+            scores.push(score(&l));
+            labels.push(l);
+            confidence.push(c);
+            residual.push(e);
         }
         if skipped {
             continue;
         }
-        for (x, v) in scores.into_iter().enumerate() {
-            sum[x] += v;
-        }
-        count += 1;
+        out.sources.push(s);
+        out.labels.push(labels);
+        out.confidence.push(confidence);
+        out.residual.push(residual);
+        out.scores.push(scores);
     }
-    Ok((count > 0).then(|| sum.iter().map(|v| v / count as f64).collect()))
+    if out.sources.is_empty() {
+        return Ok(None);
+    }
+    let count = out.sources.len() as f64;
+    out.accuracy = (0..routes.len())
+        .map(|r| out.scores.iter().map(|s| s[r]).sum::<f64>() / count)
+        .collect();
+    Ok(Some(out))
 }

@@ -53,7 +53,7 @@ pub(crate) fn rigid_route_to(
     let n = meshes.len();
     let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
     let options = RegisterOptions::default();
-    type Carried = Result<(Vec<i32>, Vec<f64>, f64), String>;
+    type Carried = Result<(Vec<i32>, Vec<f64>, f64, f64), String>;
     let results: Vec<Option<Carried>> = (0..n)
         .into_par_iter()
         .map(|i| {
@@ -76,6 +76,8 @@ pub(crate) fn rigid_route_to(
                 return Some(Err(error));
             };
             let ann = annotations[s].as_deref().unwrap_or_default();
+            let radius = rms_radius(&meshes[s]);
+            let mut residual = reg.residual;
             let carried = if affine {
                 let fit = refine_affine(
                     &meshes[s],
@@ -84,6 +86,11 @@ pub(crate) fn rigid_route_to(
                     &reg.transform,
                     AFFINE_TRIM,
                 );
+                if fit.start_residual > 0.0 && fit.residual.is_finite() {
+                    // The affine fit measures the same chamfer in source units: rescale its
+                    // improvement onto the registration's residual.
+                    residual = reg.residual * (fit.residual / fit.start_residual).min(1.0);
+                }
                 match meshes[i].map_positions(|p| fit.map.apply(p)) {
                     Ok(mapped) => nearest_point_vertex_labels(
                         &meshes[s],
@@ -102,9 +109,9 @@ pub(crate) fn rigid_route_to(
                 carried
                     .map(|(labels, dist)| {
                         // The residual is in source RMS radii; the distances in source units.
-                        let scale = rms_radius(&meshes[s]) * reg.residual.max(f64::EPSILON);
+                        let scale = radius * reg.residual.max(f64::EPSILON);
                         let conf = dist.iter().map(|d| 1.0 / (1.0 + d / scale)).collect();
-                        (labels, conf, reg.inlier_share)
+                        (labels, conf, reg.inlier_share, residual)
                     })
                     .map_err(|e| e.to_string()),
             )
@@ -115,10 +122,11 @@ pub(crate) fn rigid_route_to(
     for (i, r) in results.into_iter().enumerate() {
         match r {
             None => {}
-            Some(Ok((labels, conf, share))) => {
+            Some(Ok((labels, conf, share, residual))) => {
                 out.labels[i] = labels;
                 out.confidence[i] = conf;
                 out.shape_confidence[i] = share;
+                out.residual[i] = residual;
             }
             Some(Err(e)) => warnings.push(format!("rigid route: shape {i} not registered: {e}")),
         }
