@@ -220,7 +220,15 @@ fn run(
         }
     }
     if let Some(dir) = std::env::var_os("COSEG_DUMP") {
-        dump_run(set, std::path::Path::new(&dir), sources, annotation, score, &report, &p)?;
+        dump_run(
+            set,
+            std::path::Path::new(&dir),
+            sources,
+            annotation,
+            score,
+            &report,
+            &p,
+        )?;
     }
     let mut log = set.route_log.lock().unwrap();
     for (route, labels) in &report.routes {
@@ -311,7 +319,11 @@ fn dump_run(
             "residual": h.residual.iter().map(|r| r.iter().map(|x| if x.is_finite() { *x } else { -1.0 }).collect::<Vec<_>>()).collect::<Vec<_>>(),
         })
     });
-    let names: Vec<String> = report.routes.iter().map(|(r, _)| r.name().to_string()).collect();
+    let names: Vec<String> = report
+        .routes
+        .iter()
+        .map(|(r, _)| r.name().to_string())
+        .collect();
     let tag: Vec<String> = sources.iter().map(|s| s.to_string()).collect();
     let v = json!({"sources": sources, "routes": names, "targets": targets, "held_out": held});
     std::fs::write(

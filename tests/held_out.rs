@@ -3,7 +3,7 @@
 
 use coseg::bands::equal_count_bands;
 use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
-use coseg::propagate::{PropagateOptions, Route, held_out_accuracy};
+use coseg::propagate::{PropagateOptions, Route, held_out_accuracy, held_out_routes};
 
 /// Three shapes with the same 40-vertex band table.
 fn three_copies() -> ShapeGraph {
@@ -44,4 +44,28 @@ fn a_source_labelled_against_the_others_lowers_the_score() {
         .unwrap()
         .unwrap();
     assert!(acc[0] < 0.9, "held-out accuracy {acc:?}");
+}
+
+#[test]
+fn held_out_runs_keep_each_sources_labels_and_their_scores() {
+    let g = three_copies();
+    let half: Vec<i32> = (0..40).map(|v| if v < 20 { 0 } else { 1 }).collect();
+    let o = PropagateOptions::default();
+    let two = [Some(half.clone()), None, Some(half.clone())];
+    let h = held_out_routes(&g, &[], &two, None, &o, &[Route::Affinity], None, true)
+        .unwrap()
+        .expect("two sources: held-out runs");
+    assert_eq!(h.sources, vec![0, 2]);
+    for (k, labels) in h.labels.iter().enumerate() {
+        assert_eq!(labels[0].len(), 40);
+        let hit = labels[0].iter().zip(&half).filter(|(a, b)| a == b).count();
+        assert!((h.scores[k][0] - hit as f64 / 40.0).abs() < 1e-12);
+        assert!(h.residual[k][0].is_nan(), "the affinity has no residual");
+    }
+    let mean = (h.scores[0][0] + h.scores[1][0]) / 2.0;
+    assert!((h.accuracy[0] - mean).abs() < 1e-12);
+    let acc = held_out_accuracy(&g, &[], &two, None, &o, &[Route::Affinity], None, true)
+        .unwrap()
+        .unwrap();
+    assert_eq!(acc, h.accuracy);
 }

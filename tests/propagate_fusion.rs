@@ -375,3 +375,55 @@ fn held_out_accuracies_set_the_level_of_each_routes_trust() {
     let w = &fused.weights[1];
     assert!(w[2] > w[0] && w[2] > w[1], "weights {w:?}");
 }
+
+#[test]
+fn the_rigid_route_reports_a_residual_near_zero_for_a_moved_copy() {
+    use common::features::{blob, similarity};
+    use coseg::propagate::rigid_route;
+    let mesh = blob(3);
+    let moved = similarity(&mesh, 1.7);
+    let truth: Vec<i32> = mesh
+        .positions()
+        .iter()
+        .map(|p| i32::from(p[0] > 0.0))
+        .collect();
+    let (r, warnings) = rigid_route(&[mesh.clone(), moved], &[Some(truth.clone()), None], true);
+    assert!(warnings.is_empty(), "{warnings:?}");
+    assert!(r.residual[0].is_nan(), "the source has no residual");
+    assert!(
+        r.residual[1].is_finite() && r.residual[1] < 0.02,
+        "residual {}",
+        r.residual[1]
+    );
+    assert!(accuracy(&r.labels[1], &truth) > 0.98);
+}
+
+/// Regression (shipped humanoids from one source): a rigid alignment that collapsed (a third
+/// of the labels right) took the shape from a parts route right on 96 % of it, because the
+/// shared-failure model read the affinity and parts routes' agreement as a joint failure.
+/// That model is only for a pair reading the same intrinsic features; parts made with the
+/// extrinsic family are fused by the one-coin vote, which keeps the collapsed route out.
+#[test]
+fn a_collapsed_rigid_route_does_not_take_the_shape_from_parts_on_other_features() {
+    let d = 600;
+    let (truth, parts) = truth_and_noisy(d, 0.04, 5);
+    let (_, affinity) = truth_and_noisy(d, 0.45, 6);
+    let rigid: Vec<i32> = truth
+        .iter()
+        .enumerate()
+        .map(|(v, &l)| if v < 6 * d / 10 { (l + 1) % 3 } else { l })
+        .collect();
+    let routes = [route(affinity, 1.0), route(parts, 1.0), route(rigid, 1.0)];
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas = [vec![1.0; d], vec![1.0; d]];
+    let a: Vec<&[f64]> = areas.iter().map(|x| x.as_slice()).collect();
+    let one_coin = fuse_routes(&refs, &a);
+    assert!(
+        accuracy(&one_coin.labels[1], &truth) > 0.9,
+        "one-coin vote: {}",
+        accuracy(&one_coin.labels[1], &truth)
+    );
+    // What the shared-failure model does with it: the reason it is kept for intrinsic pairs.
+    let shared = fuse_routes_with(&refs, &a, None, Some((0, 1)));
+    assert!(accuracy(&shared.labels[1], &truth) < accuracy(&one_coin.labels[1], &truth));
+}

@@ -1,12 +1,14 @@
 //! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
 
 use super::{
-    FusedRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
-    HeldOutRoutes, fuse_routes_with, held_out_routes, parts_route, rigid_route, snap_labels,
+    FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
+    fuse_routes_with, held_out_routes, parts_route, rigid_route, snap_labels,
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
-use crate::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions, segment_collection};
+use crate::parts::{
+    FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions, segment_collection,
+};
 use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
 use serde::{Deserialize, Serialize};
@@ -78,7 +80,12 @@ impl RouteOptions {
 pub struct CollectionParts {
     nodes: Vec<ShapeNode>,
     options: SegmentCollectionOptions,
-    made: BTreeMap<usize, Cosegmentation>,
+    /// Whether the per-shape pipeline holds the intrinsic family alone (no extrinsic, SDF or
+    /// user columns): what the parts read when their families are taken as given.
+    intrinsic_pipeline: bool,
+    /// Per number of parts: the co-segmentation and whether it read the intrinsic family
+    /// alone.
+    made: BTreeMap<usize, (Cosegmentation, bool)>,
 }
 
 impl CollectionParts {
@@ -101,9 +108,11 @@ impl CollectionParts {
             cue_cache,
             ..Default::default()
         };
+        let f = &pipeline.families;
         CollectionParts {
             nodes,
             options,
+            intrinsic_pipeline: f.extrinsic.is_none() && f.sdf.is_none() && f.user.is_none(),
             made: BTreeMap::new(),
         }
     }
@@ -128,9 +137,19 @@ impl CollectionParts {
                 None,
             );
             let s = segment_collection(self.nodes.clone(), meshes, &o)?;
-            self.made.insert(count, s.segmentation);
+            let intrinsic = s.features.as_ref().map_or(self.intrinsic_pipeline, |c| {
+                c.chosen == FeatureSet::Intrinsic
+            });
+            self.made.insert(count, (s.segmentation, intrinsic));
         }
-        Ok(&self.made[&count])
+        Ok(&self.made[&count].0)
+    }
+
+    /// Whether the co-segmentation into `count` parts, once made, read the intrinsic family
+    /// alone (the families chosen from the data, or the pipeline's when taken as given);
+    /// `None` before [`Self::parts`] made it.
+    pub fn intrinsic_only(&self, count: usize) -> Option<bool> {
+        self.made.get(&count).map(|m| m.1)
     }
 }
 
@@ -199,10 +218,13 @@ pub fn fuse_propagation(
     }
     report.routes.push((Route::Affinity, affinity));
     let mut segmentation = None;
+    let mut parts_intrinsic = false;
     if let (true, Some(parts)) = (options.parts, parts) {
         let count = propagation.parts.len();
         match parts.parts(count, meshes) {
-            Ok(seg) => {
+            Ok(_) => {
+                parts_intrinsic = parts.intrinsic_only(count).unwrap_or(true);
+                let seg = parts.parts(count, meshes)?;
                 report
                     .routes
                     .push((Route::Parts, parts_route(seg, annotations, &areas)));
@@ -231,11 +253,19 @@ pub fn fuse_propagation(
     )?;
     report.held_out = report.held_out_runs.as_ref().map(|h| h.accuracy.clone());
     let refs: Vec<&RouteLabels> = report.routes.iter().map(|(_, r)| r).collect();
-    // The two routes that read the intrinsic band features may fail together.
+    // The band affinity and the parts route fail together where both read the intrinsic
+    // family alone (parts on the intrinsic family imply a pipeline without other families,
+    // so the affinity reads it alone too): intrinsic descriptors cannot tell a part from its mirror image, so both
+    // confuse the same pairs. Parts made with the extrinsic family (an aligned collection,
+    // chosen from the data) do not share that failure, and modelling a shared failure that
+    // is not there reads a rigid alignment that collapsed (agreeing with neither) as the
+    // pair failing together and hands the shape to it (shipped humanoids from one source:
+    // docs/PROPAGATION.md).
     let shared = names
         .iter()
         .position(|&r| r == Route::Affinity)
-        .zip(names.iter().position(|&r| r == Route::Parts));
+        .zip(names.iter().position(|&r| r == Route::Parts))
+        .filter(|_| parts_intrinsic);
     report.fused = fuse_routes_with(&refs, &areas, report.held_out.as_deref(), shared);
     let snapped = snap_labels(meshes, &report.fused.labels, options.snap_band)?;
     for (i, labels) in snapped.into_iter().enumerate() {
