@@ -1,8 +1,10 @@
 //! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
 
+use super::held_out::held_out_routes_cached;
+use super::rigid_route::rigid_route_cached;
 use super::{
     FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
-    fuse_routes_with, held_out_routes, parts_route, rigid_route, snap_labels,
+    fuse_routes_with, parts_route, snap_labels,
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
@@ -236,12 +238,19 @@ pub fn fuse_propagation(
         }
     }
     if options.rigid {
-        let (rigid, warnings) = rigid_route(meshes, annotations, options.affine);
+        let targets: Vec<usize> = (0..n).filter(|&i| annotations[i].is_none()).collect();
+        let (rigid, warnings) = rigid_route_cached(
+            meshes,
+            annotations,
+            options.affine,
+            &targets,
+            &propagation.rigid,
+        );
         report.warnings.extend(warnings);
         report.routes.push((Route::Rigid, rigid));
     }
     let names: Vec<Route> = report.routes.iter().map(|(r, _)| *r).collect();
-    report.held_out_runs = held_out_routes(
+    report.held_out_runs = held_out_routes_cached(
         graph,
         meshes,
         annotations,
@@ -250,6 +259,7 @@ pub fn fuse_propagation(
         &names,
         segmentation,
         options.affine,
+        &propagation.rigid,
     )?;
     report.held_out = report.held_out_runs.as_ref().map(|h| h.accuracy.clone());
     let refs: Vec<&RouteLabels> = report.routes.iter().map(|(_, r)| r).collect();

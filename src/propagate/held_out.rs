@@ -1,7 +1,7 @@
 //! [`held_out_accuracy`]: each route's accuracy measured on the sources themselves, every
 //! source's labels carried to it from the other sources.
 
-use super::rigid_route::rigid_route_to;
+use super::rigid_route::{RigidCache, rigid_route_cached};
 use super::{PropagateError, PropagateOptions, Route, parts_route, propagate_labels};
 use crate::graph::{Cosegmentation, ShapeGraph};
 use crate::mesh::TriMesh;
@@ -86,6 +86,33 @@ pub fn held_out_routes(
     segmentation: Option<&Cosegmentation>,
     affine: bool,
 ) -> Result<Option<HeldOutRoutes>, PropagateError> {
+    held_out_routes_cached(
+        graph,
+        meshes,
+        annotations,
+        smoothers,
+        propagate,
+        routes,
+        segmentation,
+        affine,
+        &RigidCache::default(),
+    )
+}
+
+/// [`held_out_routes`] with the rigid route's registrations kept in `rigid` (the fusion
+/// shares its propagation's cache, whose pairs of sources the held-out runs need).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn held_out_routes_cached(
+    graph: &ShapeGraph,
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    smoothers: Option<&[HeatSmoother]>,
+    propagate: &PropagateOptions,
+    routes: &[Route],
+    segmentation: Option<&Cosegmentation>,
+    affine: bool,
+    rigid: &RigidCache,
+) -> Result<Option<HeldOutRoutes>, PropagateError> {
     let n = annotations.len();
     let sources: Vec<usize> = (0..n)
         .filter(|&i| {
@@ -137,7 +164,7 @@ pub fn held_out_routes(
                     None => (Vec::new(), Vec::new(), f64::NAN),
                 },
                 Route::Rigid => {
-                    let r = rigid_route_to(meshes, &ann, affine, &[s]).0;
+                    let r = rigid_route_cached(meshes, &ann, affine, &[s], rigid).0;
                     (r.labels[s].clone(), r.confidence[s].clone(), r.residual[s])
                 }
             };

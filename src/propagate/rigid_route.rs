@@ -4,10 +4,13 @@
 use super::RouteLabels;
 use super::refine_affine::refine_affine;
 use crate::align::{
-    RegisterOptions, Similarity, SurfaceIndex, nearest_point_vertex_labels, register_pair,
+    RegisterOptions, Registration, Similarity, SurfaceIndex, nearest_point_vertex_labels,
+    register_pair,
 };
 use crate::mesh::TriMesh;
 use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::sync::Mutex;
 
 /// The rigid route of the fused propagation: every unlabelled shape is registered onto each
 /// source by a similarity ([`register_pair`]: rotation, uniform scale, translation, any pose)
@@ -50,9 +53,162 @@ pub(crate) fn rigid_route_to(
     affine: bool,
     targets: &[usize],
 ) -> (RouteLabels, Vec<String>) {
+    rigid_route_cached(meshes, annotations, affine, targets, &RigidCache::default())
+}
+
+/// What the rigid route learns of one (source, target) pair that does not depend on the
+/// labels: the registration and, once the pair was chosen, which source vertex each target
+/// vertex reads its label from.
+#[derive(Debug, Clone)]
+struct PairFit {
+    /// The registration, or why it failed.
+    registration: Result<Registration, String>,
+    /// Per target vertex: the source vertex whose label it takes and how far it lands from the
+    /// source's surface; made on the first call that chooses this source.
+    nearest: Option<Nearest>,
+}
+
+/// Per target vertex the source vertex it reads and its distance to the source's surface, and
+/// the pair's residual after the affine step.
+type Nearest = (Vec<i32>, Vec<f64>, f64);
+
+/// The rigid route's label-independent work, kept between propagations of one collection:
+/// per (source, target) pair the registration and the nearest source vertex of every target
+/// vertex. A change of labels then costs one table look-up per vertex instead of a
+/// registration and a nearest-point search per pair. Results are those of an empty cache, bit
+/// for bit: what is kept is exactly what would be recomputed.
+///
+/// Entries are keyed by the shapes' indices and vertex counts and the affine step; a cache
+/// serves one collection of meshes (a [`super::Propagation`] keeps one for its graph).
+#[derive(Debug, Default)]
+pub(crate) struct RigidCache {
+    pairs: Mutex<BTreeMap<PairKey, PairFit>>,
+}
+
+/// (source, target, source vertices, target vertices, affine step).
+type PairKey = (usize, usize, usize, usize, bool);
+
+impl Clone for RigidCache {
+    fn clone(&self) -> Self {
+        RigidCache {
+            pairs: Mutex::new(self.lock().clone()),
+        }
+    }
+}
+
+impl PartialEq for RigidCache {
+    /// A cache never changes a result, so two propagations that agree elsewhere are equal
+    /// whatever their caches hold.
+    fn eq(&self, _: &Self) -> bool {
+        true
+    }
+}
+
+impl RigidCache {
+    fn lock(&self) -> std::sync::MutexGuard<'_, BTreeMap<PairKey, PairFit>> {
+        // A panic elsewhere cannot leave an entry half written (entries are inserted whole).
+        self.pairs.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn key(meshes: &[TriMesh], s: usize, i: usize, affine: bool) -> PairKey {
+        (
+            s,
+            i,
+            meshes[s].vertex_count(),
+            meshes[i].vertex_count(),
+            affine,
+        )
+    }
+
+    /// The registration of target `i` onto source `s` (computed on the first call).
+    fn registration(
+        &self,
+        meshes: &[TriMesh],
+        s: usize,
+        i: usize,
+        affine: bool,
+    ) -> Result<Registration, String> {
+        let key = Self::key(meshes, s, i, affine);
+        if let Some(f) = self.lock().get(&key) {
+            return f.registration.clone();
+        }
+        let registration = register_pair(&meshes[s], &meshes[i], &RegisterOptions::default())
+            .map_err(|e| e.to_string());
+        self.lock()
+            .entry(key)
+            .or_insert(PairFit {
+                registration,
+                nearest: None,
+            })
+            .registration
+            .clone()
+    }
+
+    /// Per vertex of target `i`: the vertex of source `s` it reads its label from and its
+    /// distance to the source's surface, after `reg` (and the affine step); computed on the
+    /// first call.
+    fn nearest(
+        &self,
+        meshes: &[TriMesh],
+        s: usize,
+        i: usize,
+        affine: bool,
+        reg: &Registration,
+    ) -> Result<Nearest, String> {
+        let key = Self::key(meshes, s, i, affine);
+        if let Some(n) = self.lock().get(&key).and_then(|f| f.nearest.clone()) {
+            return Ok(n);
+        }
+        // The source's vertex indices as its labels: the nearest-point rule gives each target
+        // vertex the index of the vertex whose label it would read.
+        let index: Vec<i32> = (0..meshes[s].vertex_count() as i32).collect();
+        let mut residual = reg.residual;
+        let carried = if affine {
+            let fit = refine_affine(
+                &meshes[s],
+                &SurfaceIndex::new(&meshes[s]),
+                &meshes[i],
+                &reg.transform,
+                AFFINE_TRIM,
+            );
+            if fit.start_residual > 0.0 && fit.residual.is_finite() {
+                // The affine fit measures the same chamfer in source units: rescale its
+                // improvement onto the registration's residual.
+                residual = reg.residual * (fit.residual / fit.start_residual).min(1.0);
+            }
+            match meshes[i].map_positions(|p| fit.map.apply(p)) {
+                Ok(mapped) => nearest_point_vertex_labels(
+                    &meshes[s],
+                    &index,
+                    &mapped,
+                    &Similarity::identity(),
+                ),
+                Err(_) => {
+                    nearest_point_vertex_labels(&meshes[s], &index, &meshes[i], &reg.transform)
+                }
+            }
+        } else {
+            nearest_point_vertex_labels(&meshes[s], &index, &meshes[i], &reg.transform)
+        }
+        .map(|(v, d)| (v, d, residual))
+        .map_err(|e| e.to_string())?;
+        if let Some(f) = self.lock().get_mut(&key) {
+            f.nearest = Some(carried.clone());
+        }
+        Ok(carried)
+    }
+}
+
+/// [`rigid_route_to`] keeping the label-independent work in `cache`.
+pub(crate) fn rigid_route_cached(
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    affine: bool,
+    targets: &[usize],
+    cache: &RigidCache,
+) -> (RouteLabels, Vec<String>) {
     let n = meshes.len();
     let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
-    let options = RegisterOptions::default();
     type Carried = Result<(Vec<i32>, Vec<f64>, f64, f64), String>;
     let results: Vec<Option<Carried>> = (0..n)
         .into_par_iter()
@@ -60,16 +216,16 @@ pub(crate) fn rigid_route_to(
             if annotations[i].is_some() || !targets.contains(&i) {
                 return None;
             }
-            let mut best: Option<(f64, usize, crate::align::Registration)> = None;
+            let mut best: Option<(f64, usize, Registration)> = None;
             let mut error = String::new();
             for &s in &sources {
-                match register_pair(&meshes[s], &meshes[i], &options) {
+                match cache.registration(meshes, s, i, affine) {
                     Ok(r) => {
                         if best.as_ref().is_none_or(|b| r.residual < b.0) {
                             best = Some((r.residual, s, r));
                         }
                     }
-                    Err(e) => error = e.to_string(),
+                    Err(e) => error = e,
                 }
             }
             let Some((_, s, reg)) = best else {
@@ -77,43 +233,24 @@ pub(crate) fn rigid_route_to(
             };
             let ann = annotations[s].as_deref().unwrap_or_default();
             let radius = rms_radius(&meshes[s]);
-            let mut residual = reg.residual;
-            let carried = if affine {
-                let fit = refine_affine(
-                    &meshes[s],
-                    &SurfaceIndex::new(&meshes[s]),
-                    &meshes[i],
-                    &reg.transform,
-                    AFFINE_TRIM,
-                );
-                if fit.start_residual > 0.0 && fit.residual.is_finite() {
-                    // The affine fit measures the same chamfer in source units: rescale its
-                    // improvement onto the registration's residual.
-                    residual = reg.residual * (fit.residual / fit.start_residual).min(1.0);
+            if ann.len() != meshes[s].vertex_count() {
+                return Some(Err(crate::align::AlignError::LabelCount {
+                    expected: meshes[s].vertex_count(),
+                    found: ann.len(),
+                    kind: "vertex",
                 }
-                match meshes[i].map_positions(|p| fit.map.apply(p)) {
-                    Ok(mapped) => nearest_point_vertex_labels(
-                        &meshes[s],
-                        ann,
-                        &mapped,
-                        &Similarity::identity(),
-                    ),
-                    Err(_) => {
-                        nearest_point_vertex_labels(&meshes[s], ann, &meshes[i], &reg.transform)
-                    }
-                }
-            } else {
-                nearest_point_vertex_labels(&meshes[s], ann, &meshes[i], &reg.transform)
-            };
+                .to_string()));
+            }
             Some(
-                carried
-                    .map(|(labels, dist)| {
+                cache
+                    .nearest(meshes, s, i, affine, &reg)
+                    .map(|(from, dist, residual)| {
+                        let labels = from.iter().map(|&v| ann[v as usize]).collect();
                         // The residual is in source RMS radii; the distances in source units.
                         let scale = radius * reg.residual.max(f64::EPSILON);
                         let conf = dist.iter().map(|d| 1.0 / (1.0 + d / scale)).collect();
                         (labels, conf, reg.inlier_share, residual)
-                    })
-                    .map_err(|e| e.to_string()),
+                    }),
             )
         })
         .collect();

@@ -2,6 +2,7 @@
 //! every shape of a graph.
 
 use super::part_scores::part_scores;
+use super::rigid_route::RigidCache;
 use super::{PartScore, PropagateError, PropagateOptions};
 use crate::affinity::{BandAffinity, Direction, FeaturePairing};
 use crate::graph::ShapeGraph;
@@ -44,6 +45,9 @@ pub struct Propagation {
     vote_labels: BTreeMap<(usize, usize), Vec<i32>>,
     /// The score rule and weighting the cached votes were computed with.
     vote_rule: (PartScore, bool),
+    /// The rigid route's registrations and nearest points, which do not depend on the labels:
+    /// kept so that a fusion after [`Propagation::update`] registers no pair twice.
+    pub(crate) rigid: RigidCache,
 }
 
 /// Statistics of one [`Propagation::update`].
@@ -136,6 +140,7 @@ pub fn propagate_labels(
         votes: BTreeMap::new(),
         vote_labels: BTreeMap::new(),
         vote_rule: (options.part_score, options.area_weighted),
+        rigid: RigidCache::default(),
     };
     for (i, a) in annotations.iter().enumerate() {
         if let Some(a) = a {

@@ -599,12 +599,15 @@ impl Studio {
             match self.solved.as_mut() {
                 Some(s) => {
                     let smoothers = (!s.smoothers.is_empty()).then_some(s.smoothers.as_slice());
+                    // The rigid route's registrations do not depend on the parts: keep them.
+                    let rigid = std::mem::take(&mut s.propagation.rigid);
                     s.propagation = propagate_labels(
                         &s.graph,
                         smoothers,
                         &self.annotations,
                         &self.options.propagate,
                     )?;
+                    s.propagation.rigid = rigid;
                     report.warnings = self.fuse_routes()?;
                 }
                 None => {
