@@ -427,3 +427,107 @@ fn a_collapsed_rigid_route_does_not_take_the_shape_from_parts_on_other_features(
     let shared = fuse_routes_with(&refs, &a, None, Some((0, 1)));
     assert!(accuracy(&shared.labels[1], &truth) < accuracy(&one_coin.labels[1], &truth));
 }
+
+/// The first four shipped goblets, copied alone into `dir/shapes`, and the labels of the first
+/// two (vertex labels of the shipped ground truth).
+fn four_goblets(dir: &std::path::Path) -> (std::path::PathBuf, Vec<Vec<i32>>) {
+    let folder = dir.join("shapes");
+    std::fs::create_dir_all(&folder).unwrap();
+    let goblets = common::generate::collections_dir().join("goblets");
+    let mut truth = Vec::new();
+    for i in 0..4 {
+        let name = format!("goblets_{i:02}");
+        std::fs::copy(
+            goblets.join(format!("{name}.obj")),
+            folder.join(format!("{name}.obj")),
+        )
+        .unwrap();
+        let labels = common::generate::read_labels(&goblets.join(format!("{name}.labels.txt")));
+        truth.push(labels.into_iter().map(|l| l as i32).collect());
+    }
+    (folder, truth)
+}
+
+#[test]
+fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() {
+    // The propagation keeps the rigid route's registrations and nearest points between
+    // fusions; after an update that adds a second source (new pairs, and kept ones from the
+    // first fusion), the rigid route and the held-out accuracies must be those computed from
+    // nothing, bit for bit.
+    use coseg::propagate::{
+        PropagateCollectionOptions, Route, fuse_propagation, held_out_accuracy, propagate_loaded,
+        rigid_route,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (folder, truth) = four_goblets(dir.path());
+    let mut o = PropagateCollectionOptions::default();
+    o.pipeline = common::features::small_pipeline(30, 8);
+    o.cache_dir = Some(dir.path().join("cache"));
+    let loaded = coseg::graph::load_collection(
+        &folder,
+        &o.pipeline,
+        o.cache_dir.as_ref().unwrap(),
+        |_, _, _| {},
+    )
+    .unwrap();
+    let meshes = loaded.meshes;
+    let first = vec![Some(truth[0].clone()), None, None, None];
+    let mut out = propagate_loaded(loaded.nodes, &meshes, &first, &o).unwrap();
+    let smoothers = (!out.smoothers.is_empty()).then_some(out.smoothers.as_slice());
+    out.propagation
+        .update(&out.graph, smoothers, 1, Some(truth[1].clone()), &o.propagate)
+        .unwrap();
+    let second = vec![Some(truth[0].clone()), Some(truth[1].clone()), None, None];
+    let report = fuse_propagation(
+        &out.graph,
+        &meshes,
+        &second,
+        &mut out.propagation,
+        out.parts.as_mut(),
+        smoothers,
+        &o.propagate,
+        &o.routes,
+    )
+    .unwrap();
+    let (fresh, _) = rigid_route(&meshes, &second, o.routes.affine);
+    let kept = &report
+        .routes
+        .iter()
+        .find(|(r, _)| *r == Route::Rigid)
+        .expect("the rigid route ran")
+        .1;
+    assert_eq!(kept.labels, fresh.labels);
+    let bits = |v: &[Vec<f64>]| -> Vec<Vec<u64>> {
+        v.iter()
+            .map(|x| x.iter().map(|c| c.to_bits()).collect())
+            .collect()
+    };
+    assert_eq!(bits(&kept.confidence), bits(&fresh.confidence));
+    assert_eq!(
+        bits(std::slice::from_ref(&kept.shape_confidence)),
+        bits(std::slice::from_ref(&fresh.shape_confidence))
+    );
+    let names: Vec<Route> = report.routes.iter().map(|(r, _)| *r).collect();
+    let count = out.propagation.parts.len();
+    let segmentation = out
+        .parts
+        .as_mut()
+        .map(|p| p.parts(count, &meshes).unwrap().clone());
+    let held_out = held_out_accuracy(
+        &out.graph,
+        &meshes,
+        &second,
+        smoothers,
+        &o.propagate,
+        &names,
+        segmentation.as_ref(),
+        o.routes.affine,
+    )
+    .unwrap()
+    .expect("two sources");
+    let reported = report.held_out.expect("two sources");
+    assert_eq!(
+        bits(std::slice::from_ref(&reported)),
+        bits(std::slice::from_ref(&held_out))
+    );
+}
