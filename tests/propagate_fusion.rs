@@ -524,6 +524,10 @@ fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() 
         bits(std::slice::from_ref(&kept.shape_confidence)),
         bits(std::slice::from_ref(&fresh.shape_confidence))
     );
+    assert_eq!(
+        bits(std::slice::from_ref(&kept.residual)),
+        bits(std::slice::from_ref(&fresh.residual))
+    );
     let names: Vec<Route> = report.routes.iter().map(|(r, _)| *r).collect();
     let count = out.propagation.parts.len();
     let segmentation = out
