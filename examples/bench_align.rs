@@ -170,11 +170,24 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     }
     let mean = nearest_rotation(m);
     let mut within = 0;
+    let mut up_within = 0;
     for (i, (f, sh)) in files.iter().zip(&a.shapes).enumerate() {
         let e = error_of(i, &mean);
         within += usize::from(e <= 5.0);
+        // Where the shape's file +y (up in every shipped family and the COSEG chairs) lands,
+        // against where the common frame puts it: the up axis alone, whatever the turn about
+        // it (what a posed body can be expected to get right).
+        let up_error = {
+            let (u, v) = (
+                net[i].rotation.map(|r| r[1]),
+                mean.rotation.map(|r| r[1]),
+            );
+            let dot: f64 = (0..3).map(|k| u[k] * v[k]).sum();
+            dot.clamp(-1.0, 1.0).acos().to_degrees()
+        };
+        up_within += usize::from(up_error <= 5.0);
         println!(
-            "{f}\terror {e:.1}° (own symmetries {})\tconfidence {:.2}\tresidual {}\tambiguity {}",
+            "{f}\terror {e:.1}° (own symmetries {})\tup error {up_error:.1}°\tconfidence {:.2}\tresidual {}\tambiguity {}",
             sh.symmetries.len(),
             sh.confidence,
             sh.residual.map_or("-".into(), |r| format!("{r:.4}")),
@@ -184,7 +197,7 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     println!(
-        "{:?}: {} shapes ({vertices} vertices), {} edges, given-frame share {:.2}, up {:?}, forward {:?}, axis of revolution (forgiven) {:?}; within 5° of the common frame: {within} of {} ({:.1} %); {wall:.2} s wall ({:.3} s per shape)",
+        "{:?}: {} shapes ({vertices} vertices), {} edges, given-frame share {:.2}, up {:?}, forward {:?}, axis of revolution (forgiven) {:?}; within 5° of the common frame: {within} of {} ({:.1} %); file +y within 5° of the common frame's: {up_within}; {wall:.2} s wall ({:.3} s per shape)",
         a.case,
         meshes.len(),
         a.edges.len(),
