@@ -178,10 +178,7 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
         // against where the common frame puts it: the up axis alone, whatever the turn about
         // it (what a posed body can be expected to get right).
         let up_error = {
-            let (u, v) = (
-                net[i].rotation.map(|r| r[1]),
-                mean.rotation.map(|r| r[1]),
-            );
+            let (u, v) = (net[i].rotation.map(|r| r[1]), mean.rotation.map(|r| r[1]));
             let dot: f64 = (0..3).map(|k| u[k] * v[k]).sum();
             dot.clamp(-1.0, 1.0).acos().to_degrees()
         };

@@ -1,6 +1,9 @@
 //! The alignment stage: similarity algebra, exact closest points, pairwise registration of
 //! moved copies, nearest-point labels.
 
+mod common;
+
+use common::motion::{random_similarity, unit};
 use coseg::align::{
     AlignError, AlignOptions, FrameCase, RegisterOptions, Similarity, align_collection,
     closest_surface_points, nearest_point_labels, nearest_point_vertex_labels, register_pair,
@@ -8,7 +11,6 @@ use coseg::align::{
 use coseg::mesh::{TriMesh, read_mesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_chacha::rand_core::Rng;
 use std::path::Path;
 
 fn shipped(family: &str, i: usize) -> TriMesh {
@@ -17,48 +19,6 @@ fn shipped(family: &str, i: usize) -> TriMesh {
         .join(family)
         .join(format!("{family}_{i:02}.obj"));
     read_mesh(&p).unwrap()
-}
-
-fn unit(rng: &mut ChaCha8Rng) -> f64 {
-    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-}
-
-/// A uniformly random rotation (unit quaternion from four normals by Box–Muller), scale in
-/// 0.5–2 and translation within ±10.
-fn random_similarity(rng: &mut ChaCha8Rng) -> Similarity {
-    let mut q = [0.0f64; 4];
-    for k in 0..2 {
-        let (u1, u2) = (unit(rng).max(1e-12), unit(rng));
-        let r = (-2.0 * u1.ln()).sqrt();
-        q[2 * k] = r * (std::f64::consts::TAU * u2).cos();
-        q[2 * k + 1] = r * (std::f64::consts::TAU * u2).sin();
-    }
-    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let [w, x, y, z] = q.map(|v| v / n);
-    let rotation = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
-    let scale = 0.5 * 4f64.powf(unit(rng));
-    let translation = [0, 1, 2].map(|_| 20.0 * unit(rng) - 10.0);
-    Similarity {
-        rotation,
-        scale,
-        translation,
-    }
 }
 
 fn dist(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -1,11 +1,13 @@
 //! `coseg align`, the real binary: already-aligned input left bit for bit, a moved collection
 //! brought back to one frame, clear errors.
 
+mod common;
+
+use common::motion::random_similarity;
 use coseg::align::Similarity;
 use coseg::mesh::{read_mesh, write_mesh};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
-use rand_chacha::rand_core::Rng;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
@@ -20,44 +22,6 @@ fn family(name: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("collections")
         .join(name)
-}
-
-fn unit(rng: &mut ChaCha8Rng) -> f64 {
-    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-}
-
-/// Uniform rotation (unit quaternion from four normals), scale 0.5–2, translation ±10.
-fn random_similarity(rng: &mut ChaCha8Rng) -> Similarity {
-    let mut q = [0.0f64; 4];
-    for k in 0..2 {
-        let (u1, u2) = (unit(rng).max(1e-12), unit(rng));
-        let r = (-2.0 * u1.ln()).sqrt();
-        q[2 * k] = r * (std::f64::consts::TAU * u2).cos();
-        q[2 * k + 1] = r * (std::f64::consts::TAU * u2).sin();
-    }
-    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let [w, x, y, z] = q.map(|v| v / n);
-    Similarity {
-        rotation: [
-            [
-                1.0 - 2.0 * (y * y + z * z),
-                2.0 * (x * y - w * z),
-                2.0 * (x * z + w * y),
-            ],
-            [
-                2.0 * (x * y + w * z),
-                1.0 - 2.0 * (x * x + z * z),
-                2.0 * (y * z - w * x),
-            ],
-            [
-                2.0 * (x * z - w * y),
-                2.0 * (y * z + w * x),
-                1.0 - 2.0 * (x * x + y * y),
-            ],
-        ],
-        scale: 0.5 * 4f64.powf(unit(rng)),
-        translation: [0, 1, 2].map(|_| 20.0 * unit(rng) - 10.0),
-    }
 }
 
 fn transforms(out: &Path) -> serde_json::Value {

@@ -6,6 +6,7 @@ pub mod features;
 pub mod generate;
 pub mod graph;
 pub mod mesh;
+pub mod motion;
 pub mod shapes;
 pub mod stable;
 pub mod studio;

@@ -1,0 +1,156 @@
+//! End to end: the real `coseg` binary's bare `segment` and `propagate` on a shipped family,
+//! as shipped and with every shape given a seeded random rotation, scale (0.5–2) and
+//! translation (issue 39: the results should not depend on how the files are oriented). The
+//! scores of the moved collection are compared with the unmoved one's.
+
+mod common;
+
+use common::generate::collections_dir;
+use common::motion::random_similarity;
+use coseg::evaluate::{GroundTruth, matched_scores, read_labels};
+use coseg::mesh::{read_mesh, write_mesh};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The shipped family `family` with every mesh moved by a similarity drawn from `seed`
+/// (vertex order kept, so the ground-truth labels still apply), written to a scratch folder.
+fn moved_copy(family: &str, seed: u64) -> PathBuf {
+    let input = collections_dir().join(family);
+    let out = scratch(&format!("{family}_moved_{seed}"));
+    std::fs::create_dir_all(&out).unwrap();
+    let truth = GroundTruth::read(&input).unwrap();
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    for s in &truth.manifest.shapes {
+        let t = random_similarity(&mut rng);
+        let m = read_mesh(input.join(&s.mesh))
+            .unwrap()
+            .map_positions(|p| t.apply(p))
+            .unwrap();
+        write_mesh(out.join(&s.mesh), &m, &[]).unwrap();
+    }
+    out
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let p = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!("e2e_invariance_{name}"));
+    if p.exists() {
+        std::fs::remove_dir_all(&p).unwrap();
+    }
+    p
+}
+
+fn coseg(args: &[&std::ffi::OsStr]) {
+    let run = Command::new(env!("CARGO_BIN_EXE_coseg"))
+        .args(args)
+        .args(["-q", "--no-pictures"])
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
+
+/// Bare `coseg segment FOLDER -o OUT`: vertex accuracy of the region ids mapped to the
+/// family's grouped parts (pooled over the shapes).
+fn segment_accuracy(family: &str, folder: &Path, tag: &str) -> f64 {
+    let out = scratch(&format!("{family}_segment_{tag}"));
+    coseg(&[
+        "segment".as_ref(),
+        folder.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    let truth = GroundTruth::read(collections_dir().join(family)).unwrap();
+    let shapes: Vec<(Vec<i32>, Vec<i32>)> = truth
+        .manifest
+        .shapes
+        .iter()
+        .map(|s| {
+            let found = read_labels(out.join(format!("{}.regions.txt", s.name))).unwrap();
+            let parts = truth.grouped_labels(&s.name).unwrap();
+            (found, parts.into_iter().map(|p| p as i32).collect())
+        })
+        .collect();
+    matched_scores(&shapes).unwrap().accuracy
+}
+
+/// Bare `coseg propagate FOLDER --labels <first shape's labels> -o OUT`: vertex accuracy of
+/// the labels carried to the other shapes (pooled).
+fn propagate_accuracy(family: &str, folder: &Path, tag: &str) -> f64 {
+    let input = collections_dir().join(family);
+    let out = scratch(&format!("{family}_propagate_{tag}"));
+    let truth = GroundTruth::read(&input).unwrap();
+    let source = &truth.manifest.shapes[0];
+    let labels = input.join(format!("{}.labels.txt", source.name));
+    coseg(&[
+        "propagate".as_ref(),
+        folder.as_os_str(),
+        "--labels".as_ref(),
+        labels.as_os_str(),
+        "-o".as_ref(),
+        out.as_os_str(),
+    ]);
+    let (mut right, mut all) = (0usize, 0usize);
+    for s in &truth.manifest.shapes[1..] {
+        let found = read_labels(out.join(format!("{}.labels.txt", s.name))).unwrap();
+        let expected = read_labels(input.join(format!("{}.labels.txt", s.name))).unwrap();
+        assert_eq!(found.len(), expected.len());
+        right += found.iter().zip(&expected).filter(|(a, b)| a == b).count();
+        all += expected.len();
+    }
+    right as f64 / all as f64
+}
+
+/// Both commands on `family` as shipped and moved by `seed`: the two scores of each, which
+/// the test prints and compares.
+fn invariance(family: &str, seed: u64) {
+    let shipped = collections_dir().join(family);
+    let moved = moved_copy(family, seed);
+    let segment = (
+        segment_accuracy(family, &shipped, "shipped"),
+        segment_accuracy(family, &moved, "moved"),
+    );
+    let propagate = (
+        propagate_accuracy(family, &shipped, "shipped"),
+        propagate_accuracy(family, &moved, "moved"),
+    );
+    println!(
+        "{family}, moved by seed {seed}: segment {:.1} % / {:.1} %, propagate {:.1} % / {:.1} % (shipped / moved)",
+        100.0 * segment.0,
+        100.0 * segment.1,
+        100.0 * propagate.0,
+        100.0 * propagate.1
+    );
+    // Issue 39's bar: within 1 point of the unmoved collection.
+    assert!(
+        (segment.0 - segment.1).abs() <= 0.01,
+        "segment {segment:?} (shipped, moved)"
+    );
+    assert!(
+        (propagate.0 - propagate.1).abs() <= 0.01,
+        "propagate {propagate:?} (shipped, moved)"
+    );
+}
+
+// Not met at commit cfce689 (the same commands with the release binary, each shape moved by a
+// seeded rotation, scale and translation: `coseg segment` / `coseg propagate` accuracy,
+// shipped → moved): chairs 82.9 → 67.4 % / 68.5 → 54.6 %, quadrupeds 94.1 → 73.1 % /
+// 81.7 → 86.8 %. Not the alignment: scaling, translating or permuting the chairs'
+// coordinates exactly changes nothing, while rounding them by 1e-12 alone gives 80.1 % /
+// 56.6 % (docs/ALIGN.md, "Invariance of the bare commands"). Run with
+// `cargo test --release --test e2e_invariance -- --ignored`.
+#[test]
+#[ignore = "issue 39's invariance bar is not met yet (docs/ALIGN.md, Invariance)"]
+fn chairs_segment_and_propagate_do_not_depend_on_the_files_frames() {
+    invariance("chairs", 5);
+}
+
+#[test]
+#[ignore = "issue 39's invariance bar is not met yet (docs/ALIGN.md, Invariance)"]
+fn quadrupeds_segment_and_propagate_do_not_depend_on_the_files_frames() {
+    invariance("quadrupeds", 5);
+}
