@@ -13,6 +13,11 @@ use coseg::align::{AlignOptions, RegisterOptions, Similarity, align_collection, 
 use coseg::mesh::read_mesh;
 use std::time::Instant;
 
+// The seeded motion the tests give shapes (one definition for both).
+#[path = "../tests/common/motion.rs"]
+mod motion;
+use motion::random_similarity;
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     if args.first().map(String::as_str) == Some("collection") {
@@ -49,45 +54,6 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         total / meshes.len() as f64
     );
     Ok(())
-}
-
-fn unit(rng: &mut rand_chacha::ChaCha8Rng) -> f64 {
-    use rand_chacha::rand_core::Rng;
-    (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64
-}
-
-/// Uniform rotation (unit quaternion from four normals), scale 0.5–2, translation ±10.
-fn random_similarity(rng: &mut rand_chacha::ChaCha8Rng) -> Similarity {
-    let mut q = [0.0f64; 4];
-    for k in 0..2 {
-        let (u1, u2) = (unit(rng).max(1e-12), unit(rng));
-        let r = (-2.0 * u1.ln()).sqrt();
-        q[2 * k] = r * (std::f64::consts::TAU * u2).cos();
-        q[2 * k + 1] = r * (std::f64::consts::TAU * u2).sin();
-    }
-    let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
-    let [w, x, y, z] = q.map(|v| v / n);
-    Similarity {
-        rotation: [
-            [
-                1.0 - 2.0 * (y * y + z * z),
-                2.0 * (x * y - w * z),
-                2.0 * (x * z + w * y),
-            ],
-            [
-                2.0 * (x * y + w * z),
-                1.0 - 2.0 * (x * x + z * z),
-                2.0 * (y * z - w * x),
-            ],
-            [
-                2.0 * (x * z - w * y),
-                2.0 * (y * z + w * x),
-                1.0 - 2.0 * (x * x + y * y),
-            ],
-        ],
-        scale: 0.5 * 4f64.powf(unit(rng)),
-        translation: [0, 1, 2].map(|_| 20.0 * unit(rng) - 10.0),
-    }
 }
 
 fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
