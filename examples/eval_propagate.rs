@@ -599,6 +599,24 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     eprintln!(
         "options: {options:?}, graph: {graph:?}, features {features} (up {up}, weights {weights:?})"
     );
+    let load_files = |files: &[PathBuf]| {
+        load(
+            files,
+            &cache,
+            &pipeline,
+            &graph,
+            options.smoothing_time,
+            &routes,
+        )
+    };
+    // The collection with the rigid route's registrations kept when it is fused.
+    let load_set = |files: &[PathBuf]| -> Result<Set, Box<dyn std::error::Error>> {
+        let mut set = load_files(files)?;
+        if route_rigid {
+            set.rigid = Some(Mutex::default());
+        }
+        Ok(set)
+    };
     match mode.as_str() {
         "chairs" => {
             let dir = rest.first().ok_or("chairs DIR")?;
@@ -611,17 +629,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .and_then(|s| s.parse::<u64>().ok())
                     .unwrap_or(u64::MAX)
             });
-            let mut set = load(
-                &files,
-                &cache,
-                &pipeline,
-                &graph,
-                options.smoothing_time,
-                &routes,
-            )?;
-            if route_rigid {
-                set.rigid = Some(Mutex::default());
-            }
+            let set = load_set(&files)?;
             let mut gt: Vec<Vec<i32>> = set
                 .names
                 .iter()
@@ -681,17 +689,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // A shipped collection: meshes and `<stem>.labels.txt` (per vertex) in one folder.
             let dir = rest.first().ok_or("labelled DIR")?;
             let files = coseg::graph::mesh_files(dir)?;
-            let mut set = load(
-                &files,
-                &cache,
-                &pipeline,
-                &graph,
-                options.smoothing_time,
-                &routes,
-            )?;
-            if route_rigid {
-                set.rigid = Some(Mutex::default());
-            }
+            let set = load_set(&files)?;
             let groups = part_groups(dir)?;
             let gt: Vec<Vec<i32>> = set
                 .names
@@ -723,14 +721,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             // Timing, warm cache: MESH... (the first two are labelled), `--seg DIR` for face
             // labels by stem (else 6 farthest-point parts of each labelled shape), `--reps N`.
             let t = Instant::now();
-            let set = load(
-                &rest,
-                &cache,
-                &pipeline,
-                &graph,
-                options.smoothing_time,
-                &routes,
-            )?;
+            let set = load_files(&rest)?;
             let t_load = t.elapsed().as_secs_f64();
             let ann = |i: usize| -> Vec<i32> {
                 match &seg {
@@ -746,17 +737,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             bench(&set, &ann, &options, reps, t_load)
         }
         "identity" => {
-            let mut set = load(
-                &rest,
-                &cache,
-                &pipeline,
-                &graph,
-                options.smoothing_time,
-                &routes,
-            )?;
-            if route_rigid {
-                set.rigid = Some(Mutex::default());
-            }
+            let set = load_set(&rest)?;
             let truth = match parts_from.as_str() {
                 "voronoi" => voronoi_parts(&set.meshes[0], parts),
                 "features" => {

@@ -3,7 +3,9 @@
 
 use coseg::bands::equal_count_bands;
 use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
-use coseg::propagate::{PropagateOptions, Route, held_out_accuracy, held_out_routes};
+use coseg::propagate::{
+    HeldOutInputs, PropagateOptions, Route, held_out_accuracy, held_out_routes,
+};
 
 /// Three shapes with the same 40-vertex band table.
 fn three_copies() -> ShapeGraph {
@@ -15,19 +17,38 @@ fn three_copies() -> ShapeGraph {
     ShapeGraph::build(nodes, &GraphOptions::default()).unwrap()
 }
 
+/// The affinity route alone, held out over `annotations` on `graph` (no meshes, no
+/// segmentation).
+fn affinity_only<'a>(
+    graph: &'a ShapeGraph,
+    annotations: &'a [Option<Vec<i32>>],
+    propagate: &'a PropagateOptions,
+) -> HeldOutInputs<'a> {
+    HeldOutInputs {
+        graph,
+        meshes: &[],
+        annotations,
+        smoothers: None,
+        propagate,
+        routes: &[Route::Affinity],
+        segmentation: None,
+        affine: true,
+    }
+}
+
 #[test]
 fn identical_sources_score_each_other_fully_and_one_source_gives_nothing() {
     let g = three_copies();
     let half: Vec<i32> = (0..40).map(|v| if v < 20 { 0 } else { 1 }).collect();
     let o = PropagateOptions::default();
     let two = [Some(half.clone()), Some(half.clone()), None];
-    let acc = held_out_accuracy(&g, &[], &two, None, &o, &[Route::Affinity], None, true)
+    let acc = held_out_accuracy(&affinity_only(&g, &two, &o))
         .unwrap()
         .expect("two sources: a held-out score");
     assert_eq!(acc.len(), 1);
     assert!(acc[0] > 0.99, "held-out accuracy {acc:?}");
     let one = [Some(half), None, None];
-    let none = held_out_accuracy(&g, &[], &one, None, &o, &[Route::Affinity], None, true);
+    let none = held_out_accuracy(&affinity_only(&g, &one, &o));
     assert!(none.unwrap().is_none());
 }
 
@@ -40,7 +61,7 @@ fn a_source_labelled_against_the_others_lowers_the_score() {
     let swapped: Vec<i32> = half.iter().map(|l| 1 - l).collect();
     let o = PropagateOptions::default();
     let ann = [Some(half.clone()), Some(half), Some(swapped)];
-    let acc = held_out_accuracy(&g, &[], &ann, None, &o, &[Route::Affinity], None, true)
+    let acc = held_out_accuracy(&affinity_only(&g, &ann, &o))
         .unwrap()
         .unwrap();
     assert!(acc[0] < 0.9, "held-out accuracy {acc:?}");
@@ -52,7 +73,7 @@ fn held_out_runs_keep_each_sources_labels_and_their_scores() {
     let half: Vec<i32> = (0..40).map(|v| if v < 20 { 0 } else { 1 }).collect();
     let o = PropagateOptions::default();
     let two = [Some(half.clone()), None, Some(half.clone())];
-    let h = held_out_routes(&g, &[], &two, None, &o, &[Route::Affinity], None, true)
+    let h = held_out_routes(&affinity_only(&g, &two, &o))
         .unwrap()
         .expect("two sources: held-out runs");
     assert_eq!(h.sources, vec![0, 2]);
@@ -64,7 +85,7 @@ fn held_out_runs_keep_each_sources_labels_and_their_scores() {
     }
     let mean = (h.scores[0][0] + h.scores[1][0]) / 2.0;
     assert!((h.accuracy[0] - mean).abs() < 1e-12);
-    let acc = held_out_accuracy(&g, &[], &two, None, &o, &[Route::Affinity], None, true)
+    let acc = held_out_accuracy(&affinity_only(&g, &two, &o))
         .unwrap()
         .unwrap();
     assert_eq!(acc, h.accuracy);

@@ -139,17 +139,8 @@ fn a_route_worse_than_chance_gets_no_weight_and_confidences_stay_in_range() {
 fn parts_are_named_by_the_sources_majority_and_unknown_parts_say_so() {
     // Two shapes of 6 vertices, three tuples: {0,1}, {2,3}, {4,5} on both. The source
     // labels tuple 0 as 7 (one vertex 8), tuple 1 as 9, and leaves tuple 2 unlabelled.
-    let tuple = |a: u32, b: u32| RegionTuple {
-        regions: vec![vec![a, b], vec![a, b]],
-        area_fractions: vec![1.0 / 3.0; 2],
-        sweeps: 0,
-        converged: true,
-        cycled: false,
-        objective: 0.0,
-        confidence: 1.0,
-        cycle_consistency: None,
-        leftover: false,
-    };
+    let tuple =
+        |a: u32, b: u32| RegionTuple::given(vec![vec![a, b], vec![a, b]], vec![1.0 / 3.0; 2]);
     let seg = Cosegmentation {
         names: vec!["s".into(), "t".into()],
         vertices: vec![6, 6],
@@ -285,8 +276,9 @@ fn refine_affine_overlays_a_stretched_copy_that_a_similarity_cannot() {
 /// Truth in six labels over `d` vertices; a rigid-like route right except on a seeded 8 %;
 /// two intrinsic-like routes that both give the mirror label (`l ^ 1`) on the same 25 % of
 /// the vertices (the mirror parts they cannot tell apart) and elsewhere are wrong
-/// independently on a seeded 20 % each.
-fn mirror_confused(d: usize) -> (Vec<i32>, [RouteLabels; 3]) {
+/// independently on a seeded 20 % each. With the vertex areas of the two shapes (a 4-vertex
+/// source, the `d`-vertex target), all 1.
+fn mirror_confused(d: usize) -> (Vec<i32>, [RouteLabels; 3], [Vec<f64>; 2]) {
     let truth: Vec<i32> = (0..d).map(|v| (6 * v / d) as i32).collect();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(11);
     let noisy = |l: i32, p: f64, rng: &mut rand_chacha::ChaCha8Rng| {
@@ -307,7 +299,8 @@ fn mirror_confused(d: usize) -> (Vec<i32>, [RouteLabels; 3]) {
         }
         r.push(noisy(l, 0.08, &mut rng));
     }
-    (truth, [route(a, 0.5), route(b, 0.5), route(r, 0.5)])
+    let areas = [vec![1.0; 4], vec![1.0; d]];
+    (truth, [route(a, 0.5), route(b, 0.5), route(r, 0.5)], areas)
 }
 
 #[test]
@@ -315,10 +308,8 @@ fn intrinsic_routes_failing_together_do_not_outvote_the_rigid_route() {
     // Regression: from one FAUST body the band affinity and the parts route both confused
     // left and right limbs; their joint failure read as agreement under the one-coin model,
     // so the fusion (74.7 %) stayed far under the rigid route (92.1 %).
-    let d = 6000;
-    let (truth, routes) = mirror_confused(d);
+    let (truth, routes, areas) = mirror_confused(6000);
     let refs: Vec<&RouteLabels> = routes.iter().collect();
-    let areas = [vec![1.0; 4], vec![1.0; d]];
     let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
     let one_coin = accuracy(&fuse_routes(&refs, &area_refs).labels[1], &truth);
     let fused = fuse_routes_with(&refs, &area_refs, None, Some((0, 1)));
@@ -363,10 +354,8 @@ fn held_out_accuracies_set_the_level_of_each_routes_trust() {
     // as measured on the sources: the rigid route, the most accurate there, gets the largest
     // weight (the vote still adds the pair's weights where they agree: the held-out level
     // corrects the trust, not the pair's joint failures).
-    let d = 6000;
-    let (truth, routes) = mirror_confused(d);
+    let (truth, routes, areas) = mirror_confused(6000);
     let refs: Vec<&RouteLabels> = routes.iter().collect();
-    let areas = [vec![1.0; 4], vec![1.0; d]];
     let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
     let one_coin = accuracy(&fuse_routes(&refs, &area_refs).labels[1], &truth);
     let fused = fuse_routes_with(&refs, &area_refs, Some(&[0.65, 0.65, 0.92]), None);
@@ -455,8 +444,8 @@ fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() 
     // first fusion), the rigid route and the held-out accuracies must be those computed from
     // nothing, bit for bit.
     use coseg::propagate::{
-        PropagateCollectionOptions, Route, fuse_propagation, held_out_accuracy, propagate_loaded,
-        rigid_route,
+        HeldOutInputs, PropagateCollectionOptions, Route, fuse_propagation, held_out_accuracy,
+        propagate_loaded, rigid_route,
     };
     let dir = tempfile::tempdir().unwrap();
     let (folder, truth) = four_goblets(dir.path());
@@ -534,16 +523,16 @@ fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() 
         .parts
         .as_mut()
         .map(|p| p.parts(count, &meshes).unwrap().clone());
-    let held_out = held_out_accuracy(
-        &out.graph,
-        &meshes,
-        &second,
+    let held_out = held_out_accuracy(&HeldOutInputs {
+        graph: &out.graph,
+        meshes: &meshes,
+        annotations: &second,
         smoothers,
-        &o.propagate,
-        &names,
-        segmentation.as_ref(),
-        o.routes.affine,
-    )
+        propagate: &o.propagate,
+        routes: &names,
+        segmentation: segmentation.as_ref(),
+        affine: o.routes.affine,
+    })
     .unwrap()
     .expect("two sources");
     let reported = report.held_out.expect("two sources");

@@ -33,10 +33,12 @@ Per-shape options (every function that computes per-shape data takes them):
 
 from __future__ import annotations
 
+import functools
+import inspect
 import os
 from collections import namedtuple
 from pathlib import Path
-from typing import Any, Dict, List, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -213,6 +215,54 @@ def _pipeline(
     return counts
 
 
+def _per_shape_keywords(*names: str) -> Callable[[Callable[..., Any]], Callable[..., Any]]:
+    """Gives the decorated function (which takes them as ``**per_shape``) the per-shape keywords
+    ``names`` (default: all of :data:`PIPELINE_OPTIONS`) in its signature, each with the
+    library's default (``help`` and :func:`inspect.signature` show them), and rejects any other
+    keyword as Python does. A keyword the function declares itself (``segment``'s
+    ``families``) keeps its own default."""
+
+    def decorate(fn: Callable[..., Any]) -> Callable[..., Any]:
+        sig = inspect.signature(fn)
+        own = [p for p in sig.parameters.values() if p.kind is not inspect.Parameter.VAR_KEYWORD]
+        declared = {p.name for p in own}
+        added = [
+            inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
+            for name, (default, annotation) in _PER_SHAPE_KEYWORDS.items()
+            if name not in declared and (not names or name in names)
+        ]
+        allowed = declared | {p.name for p in added}
+
+        @functools.wraps(fn)
+        def wrapper(*args: Any, **kwargs: Any) -> Any:
+            unknown = sorted(k for k in kwargs if k not in allowed)
+            if unknown:
+                raise TypeError(f"{fn.__name__}() got an unexpected keyword argument {unknown[0]!r}")
+            return fn(*args, **kwargs)
+
+        wrapper.__signature__ = sig.replace(parameters=own + added)  # type: ignore[attr-defined]
+        return wrapper
+
+    return decorate
+
+
+#: Default and annotation of each per-shape keyword (:data:`PIPELINE_OPTIONS`), the defaults the
+#: library's (``coseg::jobs::defaults``).
+_PER_SHAPE_KEYWORDS: Dict[str, Tuple[Any, Any]] = {
+    "eigenpairs": (_P["eigenpairs"], int),
+    "hks": (_P["hks"], int),
+    "wks": (_P["wks"], int),
+    "curvature": (_P["curvature"], int),
+    "bands": (_P["bands"], int),
+    "area_bands": (_P["area_bands"], bool),
+    "families": (_P["features"], Union[str, Sequence[str]]),
+    "up": (_P["up"], str),
+    "directions": (_P["directions"], int),
+    "family_weights": (None, Any),
+    "normals": (_P["normals"], int),
+}
+
+
 def mesh_format(path: Union[str, os.PathLike]) -> str:
     """``"obj"``, ``"off"`` or ``"ply"`` from a file name (case-insensitive)."""
     suffix = Path(path).suffix.lower()
@@ -243,19 +293,8 @@ def spectrum(V: Any, F: Any, k: int = _P["eigenpairs"]) -> Tuple[np.ndarray, np.
     return _coseg.spectrum(V, F, int(k))
 
 
-def features(
-    V: Any,
-    F: Any,
-    *,
-    families: Union[str, Sequence[str]] = _P["features"],
-    eigenpairs: int = _P["eigenpairs"],
-    hks: int = _P["hks"],
-    wks: int = _P["wks"],
-    curvature: int = _P["curvature"],
-    up: str = _P["up"],
-    directions: int = _P["directions"],
-    normals: int = _P["normals"],
-) -> Tuple[List[str], np.ndarray]:
+@_per_shape_keywords("families", "eigenpairs", "hks", "wks", "curvature", "up", "directions", "normals")
+def features(V: Any, F: Any, **per_shape: Any) -> Tuple[List[str], np.ndarray]:
     """Per-vertex descriptors: ``(names, matrix)`` with ``matrix`` ``n x N`` float64 and
     ``names[j]`` naming column ``j`` (``hks_000``, ..., ``wks_...``, ``curv_...``, then
     ``ext_...``, ``sdf_...``, ``user_...`` of the other families). ``families``: see the
@@ -264,32 +303,19 @@ def features(
     ``directions`` and ``normals`` set the extrinsic family (as ``coseg features --up
     --directions --normals``)."""
     V, F = _as_mesh(V, F)
-    counts = dict(eigenpairs=eigenpairs, hks=hks, wks=wks, curvature=curvature)
-    return _coseg.features(V, F, _pipeline(families, up, directions, None, normals, **counts))
+    return _coseg.features(V, F, _pipeline_opts(per_shape))
 
 
-def band_table(
-    V: Any,
-    F: Any,
-    *,
-    families: Union[str, Sequence[str]] = _P["features"],
-    eigenpairs: int = _P["eigenpairs"],
-    hks: int = _P["hks"],
-    wks: int = _P["wks"],
-    curvature: int = _P["curvature"],
-    bands: int = _P["bands"],
-    area_bands: bool = _P["area_bands"],
-    up: str = _P["up"],
-    directions: int = _P["directions"],
-    normals: int = _P["normals"],
-) -> np.ndarray:
+@_per_shape_keywords(
+    "families", "eigenpairs", "hks", "wks", "curvature", "bands", "area_bands", "up", "directions", "normals"
+)
+def band_table(V: Any, F: Any, **per_shape: Any) -> np.ndarray:
     """The band table: ``n x N`` uint8, entry ``(v, j)`` the band (``0..bands``) of vertex
     ``v`` in feature ``j`` (columns as :func:`features`, same ``families``, ``up``,
     ``directions``, ``normals``). Default 20 bands of equal vertex count (``area_bands=True``:
     equal area); the normal columns are cut by value into equal intervals of [0, 1]."""
     V, F = _as_mesh(V, F)
-    counts = dict(eigenpairs=eigenpairs, hks=hks, wks=wks, curvature=curvature, bands=bands, area_bands=area_bands)
-    return _coseg.band_table(V, F, _pipeline(families, up, directions, None, normals, **counts))
+    return _coseg.band_table(V, F, _pipeline_opts(per_shape))
 
 
 _PIPELINE_DOC = """Per-shape options (part of the cache key; defaults as the CLI's): ``eigenpairs`` (200),
@@ -298,38 +324,11 @@ _PIPELINE_DOC = """Per-shape options (part of the cache key; defaults as the CLI
     ``family_weights`` (1 each); see the module's docstring."""
 
 
-def _pipe(
-    eigenpairs: int,
-    hks: int,
-    wks: int,
-    curvature: int,
-    bands: int,
-    area_bands: bool,
-    families: Union[str, Sequence[str]],
-    up: str,
-    directions: int,
-    family_weights: Any,
-    normals: int,
-) -> Dict[str, Any]:
-    return _pipeline(
-        families,
-        up,
-        directions,
-        family_weights,
-        normals,
-        eigenpairs=eigenpairs,
-        hks=hks,
-        wks=wks,
-        curvature=curvature,
-        bands=bands,
-        area_bands=area_bands,
-    )
-
-
 def _path(p: Optional[Union[str, os.PathLike]]) -> Optional[str]:
     return None if p is None else os.fspath(p)
 
 
+@_per_shape_keywords()
 def pair(
     shape_a: Any,
     shape_b: Any,
@@ -353,17 +352,7 @@ def pair(
     map_preset: str = _D["pair"]["map_preset"],
     map_size: Optional[int] = _D["pair"]["map_size"],
     map_smoothing_time: Optional[float] = _D["pair"]["map_smoothing_time"],
-    eigenpairs: int = _P["eigenpairs"],
-    hks: int = _P["hks"],
-    wks: int = _P["wks"],
-    curvature: int = _P["curvature"],
-    bands: int = _P["bands"],
-    area_bands: bool = _P["area_bands"],
-    families: Union[str, Sequence[str]] = _P["features"],
-    up: str = _P["up"],
-    directions: int = _P["directions"],
-    family_weights: Any = None,
-    normals: int = _P["normals"],
+    **per_shape: Any,
 ) -> Dict[str, Any]:
     """Stable region correspondences between two shapes (``coseg pair``).
 
@@ -413,11 +402,12 @@ def pair(
         map_smoothing_time=map_smoothing_time,
         cache_dir=_path(cache_dir),
         out=_path(out),
-        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights, normals),
+        **_pipeline_opts(per_shape),
     )
     return _coseg.pair([(va, fa), (vb, fb)], list(names), opts, [xa, xb])
 
 
+@_per_shape_keywords()
 def segment(
     shapes: Any,
     *,
@@ -436,17 +426,8 @@ def segment(
     neighbours: int = _D["segment"]["neighbours"],
     refine_rounds: int = _D["segment"]["refine_rounds"],
     smoothing_time: float = _D["segment"]["smoothing_time"],
-    eigenpairs: int = _P["eigenpairs"],
-    hks: int = _P["hks"],
-    wks: int = _P["wks"],
-    curvature: int = _P["curvature"],
-    bands: int = _P["bands"],
-    area_bands: bool = _P["area_bands"],
     families: Optional[Union[str, Sequence[str]]] = None,
-    up: str = _P["up"],
-    directions: int = _P["directions"],
-    family_weights: Any = None,
-    normals: int = _P["normals"],
+    **per_shape: Any,
 ) -> Dict[str, Any]:
     """Consistent co-segmentation of a collection (``coseg segment``).
 
@@ -506,8 +487,7 @@ def segment(
         smoothing_time=smoothing_time,
         cache_dir=_path(cache_dir),
         out=_path(out),
-        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands,
-                _P["features"] if families is None else families, up, directions, family_weights, normals),
+        **_pipeline_opts(dict(per_shape, families=_P["features"] if families is None else families)),
     )
     if families is None:
         # As `coseg segment` without --features: the library chooses the families.
@@ -537,6 +517,7 @@ def _label_array(labels: Any, what: str) -> Union[None, str, np.ndarray]:
     return np.ascontiguousarray(a, dtype=np.int64)
 
 
+@_per_shape_keywords()
 def propagate(
     shapes: Any,
     labels: Any,
@@ -555,17 +536,7 @@ def propagate(
     area_weighted: bool = _D["propagate"]["area_weighted"],
     map_step: bool = False,
     map_agreement: float = _D["propagate"]["map_agreement"],
-    eigenpairs: int = _P["eigenpairs"],
-    hks: int = _P["hks"],
-    wks: int = _P["wks"],
-    curvature: int = _P["curvature"],
-    bands: int = _P["bands"],
-    area_bands: bool = _P["area_bands"],
-    families: Union[str, Sequence[str]] = _P["features"],
-    up: str = _P["up"],
-    directions: int = _P["directions"],
-    family_weights: Any = None,
-    normals: int = _P["normals"],
+    **per_shape: Any,
 ) -> Dict[str, Any]:
     """Part labels from a few annotated shapes to a whole collection (``coseg propagate``).
 
@@ -629,7 +600,7 @@ def propagate(
         map_agreement=map_agreement,
         cache_dir=_path(cache_dir),
         out=_path(out),
-        **_pipe(eigenpairs, hks, wks, curvature, bands, area_bands, families, up, directions, family_weights, normals),
+        **_pipeline_opts(per_shape),
     )
     if isinstance(part_names, (str, os.PathLike)):
         opts["part_names"] = os.fspath(part_names)

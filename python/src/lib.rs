@@ -529,11 +529,7 @@ fn propagate<'py>(
         .detach(|| run_propagate(input, &job))
         .map_err(|e| lib_err(&e))?;
     let (result, summary) = (&outcome.result, &outcome.summary);
-    let outcomes: Vec<&str> = outcome
-        .cache_outcomes
-        .iter()
-        .map(outcome_name)
-        .collect();
+    let outcomes: Vec<&str> = outcome.cache_outcomes.iter().map(outcome_name).collect();
     let p = &result.propagation;
     let n = result.graph.node_count();
     let d = PyDict::new(py);

@@ -41,6 +41,19 @@ impl<'py> Opts<'py> {
         })
     }
 
+    /// Removes `key` and, when present and not `None`, converts it into `field`; an absent key
+    /// keeps the field's value (the library's default).
+    pub fn set<T: for<'a> FromPyObject<'a, 'py>>(
+        &mut self,
+        key: &str,
+        field: &mut T,
+    ) -> PyResult<()> {
+        if let Some(v) = self.take(key)? {
+            *field = v;
+        }
+        Ok(())
+    }
+
     /// Errors on any key not consumed.
     pub fn finish(self) -> PyResult<()> {
         match &self.0 {
@@ -63,36 +76,16 @@ impl<'py> Opts<'py> {
     pub fn pipeline(&mut self) -> PyResult<ShapePipelineOptions> {
         let mut p = ShapePipelineOptions::default();
         let mut flags = FamilyFlags::default();
-        if let Some(f) = self.take("features")? {
-            flags.features = f;
-        }
-        if let Some(u) = self.take("up")? {
-            flags.up = u;
-        }
-        if let Some(n) = self.take("directions")? {
-            flags.directions = n;
-        }
-        if let Some(n) = self.take("normals")? {
-            flags.normals = n;
-        }
-        if let Some(w) = self.take("family_weights")? {
-            flags.family_weights = w;
-        }
-        if let Some(k) = self.take("eigenpairs")? {
-            p.spectrum.eigenpairs = k;
-        }
-        if let Some(k) = self.take("hks")? {
-            p.descriptors.hks_count = k;
-        }
-        if let Some(k) = self.take("wks")? {
-            p.descriptors.wks_count = k;
-        }
-        if let Some(k) = self.take("curvature")? {
-            p.descriptors.curvature_count = k;
-        }
-        if let Some(k) = self.take("bands")? {
-            p.bands.bands = k;
-        }
+        self.set("features", &mut flags.features)?;
+        self.set("up", &mut flags.up)?;
+        self.set("directions", &mut flags.directions)?;
+        self.set("normals", &mut flags.normals)?;
+        self.set("family_weights", &mut flags.family_weights)?;
+        self.set("eigenpairs", &mut p.spectrum.eigenpairs)?;
+        self.set("hks", &mut p.descriptors.hks_count)?;
+        self.set("wks", &mut p.descriptors.wks_count)?;
+        self.set("curvature", &mut p.descriptors.curvature_count)?;
+        self.set("bands", &mut p.bands.bands)?;
         if self.take::<bool>("area_bands")? == Some(true) {
             p.bands.weighting = BandWeighting::Area;
         }
@@ -104,31 +97,15 @@ impl<'py> Opts<'py> {
     /// The propagation's graph and solver options, as `coseg propagate` sets them.
     pub fn propagate(&mut self) -> PyResult<(GraphOptions, PropagateOptions)> {
         let mut graph = GraphOptions::default();
-        if let Some(v) = self.take("complete_limit")? {
-            graph.complete_limit = v;
-        }
-        if let Some(v) = self.take("neighbours")? {
-            graph.neighbours = v;
-        }
+        self.set("complete_limit", &mut graph.complete_limit)?;
+        self.set("neighbours", &mut graph.neighbours)?;
         let mut p = PropagateOptions::default();
-        if let Some(v) = self.take("smoothing_time")? {
-            p.smoothing_time = v;
-        }
-        if let Some(v) = self.take("max_sweeps")? {
-            p.max_sweeps = v;
-        }
-        if let Some(v) = self.take("network_weight")? {
-            p.network_weight = v;
-        }
-        if let Some(v) = self.take("similarity_power")? {
-            p.similarity_power = v;
-        }
-        if let Some(v) = self.take("size_prior")? {
-            p.size_prior = v;
-        }
-        if let Some(v) = self.take("area_weighted")? {
-            p.area_weighted = v;
-        }
+        self.set("smoothing_time", &mut p.smoothing_time)?;
+        self.set("max_sweeps", &mut p.max_sweeps)?;
+        self.set("network_weight", &mut p.network_weight)?;
+        self.set("similarity_power", &mut p.similarity_power)?;
+        self.set("size_prior", &mut p.size_prior)?;
+        self.set("area_weighted", &mut p.area_weighted)?;
         Ok((graph, p))
     }
 
@@ -170,21 +147,11 @@ impl<'py> Opts<'py> {
         job.snap_band = self.take("snap_band")?;
         job.area_fraction = self.take("area_fraction")?;
         job.seed = self.take("seed")?;
-        if let Some(v) = self.take("complete_limit")? {
-            job.graph.complete_limit = v;
-        }
-        if let Some(v) = self.take("neighbours")? {
-            job.graph.neighbours = v;
-        }
-        if let Some(v) = self.take("refine_rounds")? {
-            job.refine_rounds = v;
-        }
-        if let Some(v) = self.take("smoothing_time")? {
-            job.smoothing_time = v;
-        }
-        if let Some(n) = self.take("starts")? {
-            job.starts = n;
-        }
+        self.set("complete_limit", &mut job.graph.complete_limit)?;
+        self.set("neighbours", &mut job.graph.neighbours)?;
+        self.set("refine_rounds", &mut job.refine_rounds)?;
+        self.set("smoothing_time", &mut job.smoothing_time)?;
+        self.set("starts", &mut job.starts)?;
         if let Some(r) = self.take::<String>("refine_sizes")? {
             job.refine_sizes = r.parse::<RefineSizes>().map_err(lib)?;
         }
@@ -201,9 +168,7 @@ impl<'py> Opts<'py> {
                 _ => return Err(bad("algorithm", &a, "fixed, auto")),
             };
         }
-        if let Some(v) = self.take("pairs")? {
-            r.pairs = v;
-        }
+        self.set("pairs", &mut r.pairs)?;
         if let Some(a) = self.take::<f64>("alpha")? {
             r.p = Threshold::AreaFraction(a);
             r.q = Threshold::AreaFraction(a);
@@ -211,12 +176,8 @@ impl<'py> Opts<'py> {
         if self.take::<bool>("alpha_of_remaining")? == Some(true) {
             r.area_reference = AreaReference::Remaining;
         }
-        if let Some(v) = self.take("delta_t")? {
-            r.delta_t = v;
-        }
-        if let Some(v) = self.take("t_max")? {
-            r.t_max = v;
-        }
+        self.set("delta_t", &mut r.delta_t)?;
+        self.set("t_max", &mut r.t_max)?;
         if self.take::<bool>("linear_t")? == Some(true) {
             r.t_search = TSearch::Linear;
         }
@@ -227,12 +188,8 @@ impl<'py> Opts<'py> {
                 _ => return Err(bad("init", &a, "extreme, random")),
             };
         }
-        if let Some(v) = self.take("seed")? {
-            r.seed = v;
-        }
-        if let Some(v) = self.take("max_iterations")? {
-            r.max_iterations = v;
-        }
+        self.set("seed", &mut r.seed)?;
+        self.set("max_iterations", &mut r.max_iterations)?;
         let base = RefineOptions::default();
         let rounds = self.take("refine_rounds")?.unwrap_or(base.max_rounds);
         let time = self.take("smoothing_time")?.unwrap_or(base.smoothing_time);

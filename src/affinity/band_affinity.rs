@@ -677,8 +677,18 @@ fn chunk_count(len: usize) -> usize {
     len.div_ceil(MIN_SCATTER_CHUNK).clamp(1, SCATTER_CHUNKS)
 }
 
-/// Counts `hist[k*K + band_src[k][p]] += 1` over `p ∈ support` into `hist[..N*K]`.
-fn scatter_count(src: &BandTable, bands: usize, support: &[u32], hist: &mut [u32]) {
+/// `hist[k*K + band_src[k][p]] += value(p)` over `p ∈ support` into `hist[..N*K]`: each chunk
+/// of `support` into its own histogram, then the chunks' histograms summed in chunk order (a
+/// function of `support.len()` only, so the sums are deterministic).
+fn scatter<T>(
+    src: &BandTable,
+    bands: usize,
+    support: &[u32],
+    hist: &mut [T],
+    value: impl Fn(usize) -> T + Sync,
+) where
+    T: Copy + Default + std::ops::AddAssign + Send,
+{
     let nf = src.features;
     let len = nf * bands;
     let chunks = chunk_count(support.len());
@@ -687,46 +697,15 @@ fn scatter_count(src: &BandTable, bands: usize, support: &[u32], hist: &mut [u32
         .par_chunks_mut(len)
         .enumerate()
         .for_each(|(c, h)| {
-            h.fill(0);
+            h.fill(T::default());
             let lo = (c * per).min(support.len());
             let hi = ((c + 1) * per).min(support.len());
             for &p in &support[lo..hi] {
                 let row = src.row(p as usize);
+                let v = value(p as usize);
                 // SAFETY: every label is < bands (validated by `check_table` when the operator
                 // was built; the tables are borrowed immutably since), `row.len() == nf` and
                 // `h.len() == nf * bands`, so `k * bands + row[k] < h.len()`.
-                unsafe {
-                    for (k, &l) in row.iter().enumerate() {
-                        *h.get_unchecked_mut(k * bands + l as usize) += 1;
-                    }
-                }
-            }
-        });
-    let (first, rest) = hist.split_at_mut(len);
-    for c in 1..chunks {
-        for (a, &b) in first.iter_mut().zip(&rest[(c - 1) * len..c * len]) {
-            *a += b;
-        }
-    }
-}
-
-/// `hist[k*K + band_src[k][p]] += x_p` over `p ∈ support`, chunked and summed in chunk order.
-fn scatter_f64(src: &BandTable, bands: usize, support: &[u32], x: &[f64], hist: &mut [f64]) {
-    let nf = src.features;
-    let len = nf * bands;
-    let chunks = chunk_count(support.len());
-    let per = support.len().div_ceil(chunks);
-    hist[..chunks * len]
-        .par_chunks_mut(len)
-        .enumerate()
-        .for_each(|(c, h)| {
-            h.fill(0.0);
-            let lo = (c * per).min(support.len());
-            let hi = ((c + 1) * per).min(support.len());
-            for &p in &support[lo..hi] {
-                let row = src.row(p as usize);
-                let v = x[p as usize];
-                // SAFETY: as in `scatter_count`.
                 unsafe {
                     for (k, &l) in row.iter().enumerate() {
                         *h.get_unchecked_mut(k * bands + l as usize) += v;
@@ -740,6 +719,16 @@ fn scatter_f64(src: &BandTable, bands: usize, support: &[u32], x: &[f64], hist: 
             *a += b;
         }
     }
+}
+
+/// Counts `hist[k*K + band_src[k][p]] += 1` over `p ∈ support` into `hist[..N*K]`.
+fn scatter_count(src: &BandTable, bands: usize, support: &[u32], hist: &mut [u32]) {
+    scatter(src, bands, support, hist, |_| 1);
+}
+
+/// `hist[k*K + band_src[k][p]] += x_p` over `p ∈ support`, chunked and summed in chunk order.
+fn scatter_f64(src: &BandTable, bands: usize, support: &[u32], x: &[f64], hist: &mut [f64]) {
+    scatter(src, bands, support, hist, |p| x[p]);
 }
 
 /// A table entry [`gather`] sums, and how its sum becomes an `f64`.

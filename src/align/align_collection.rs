@@ -2,10 +2,10 @@
 //! over a shape graph.
 
 use super::AlignError;
-use super::register_pair::COARSE_ITERATIONS;
-use super::register_pair::{Pose, RegisterOptions, icp, signed_permutations};
-use super::similarity::{Similarity, rotation_angle};
-use super::surface_samples::COARSE_SAMPLES;
+use super::register_pair::{
+    Pose, RegisterOptions, angle, coarse_icp, icp, signed_permutations, to_rows,
+};
+use super::similarity::Similarity;
 use super::surface_samples::{PointIndex, Prepared};
 use crate::mesh::TriMesh;
 use nalgebra::{Matrix3, Vector3};
@@ -529,18 +529,6 @@ fn chordal_mean(rs: &[Matrix3<f64>]) -> Matrix3<f64> {
     u * Matrix3::from_diagonal(&Vector3::new(1.0, 1.0, d)) * vt
 }
 
-fn angle(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
-    rotation_angle(&to_rows(a), &to_rows(b))
-}
-
-fn to_rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
-    [
-        [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
-        [m[(1, 0)], m[(1, 1)], m[(1, 2)]],
-        [m[(2, 0)], m[(2, 1)], m[(2, 2)]],
-    ]
-}
-
 fn to_arr(v: &Vector3<f64>) -> [f64; 3] {
     [v.x, v.y, v.z]
 }
@@ -595,23 +583,9 @@ fn edge_table(s: &Prepared, t: &Prepared, cube: &Cube, options: &RegisterOptions
         .map(|p| s.moments.frame * p * t.moments.frame.transpose())
         .chain(std::iter::once(Matrix3::identity()))
         .collect();
-    let coarse_n = COARSE_SAMPLES.min(options.samples);
     let results: Vec<Pose> = starts
         .iter()
-        .map(|r| {
-            icp(
-                s,
-                t,
-                coarse_n,
-                Pose {
-                    rotation: *r,
-                    translation: Vector3::zeros(),
-                    residual: f64::INFINITY,
-                },
-                COARSE_ITERATIONS,
-                options.trim,
-            )
-        })
+        .map(|r| coarse_icp(s, t, r, options))
         .collect();
     let mut cost = [f64::INFINITY; 24];
     let mut pose: [Pose; 24] = std::array::from_fn(|k| Pose {

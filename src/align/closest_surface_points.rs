@@ -1,9 +1,7 @@
 //! Exact closest points on a triangle mesh's surface: [`SurfaceIndex`] (a bounding volume
 //! hierarchy over the triangles, built once) and [`closest_surface_points`] (many queries).
 
-use crate::mesh::TriMesh;
-use bvh::aabb::{Aabb, Bounded};
-use bvh::bounding_hierarchy::BHShape;
+use crate::mesh::{BvhTriangle, TriMesh};
 use bvh::bvh::Bvh;
 use bvh::point_query::PointDistance;
 use nalgebra::Point3;
@@ -21,29 +19,8 @@ pub struct SurfacePoint {
     pub distance: f64,
 }
 
-struct Tri {
-    corners: [Point3<f64>; 3],
-    face: usize,
-    node: usize,
-}
-
-impl Bounded<f64, 3> for Tri {
-    fn aabb(&self) -> Aabb<f64, 3> {
-        Aabb::empty()
-            .grow(&self.corners[0])
-            .grow(&self.corners[1])
-            .grow(&self.corners[2])
-    }
-}
-
-impl BHShape<f64, 3> for Tri {
-    fn set_bh_node_index(&mut self, i: usize) {
-        self.node = i;
-    }
-    fn bh_node_index(&self) -> usize {
-        self.node
-    }
-}
+/// A triangle of the hierarchy, with the index of its face.
+type Tri = BvhTriangle<usize>;
 
 impl PointDistance<f64, 3> for Tri {
     fn distance_squared(&self, q: Point3<f64>) -> f64 {
@@ -69,11 +46,7 @@ impl SurfaceIndex {
     /// The hierarchy of `mesh`'s triangles.
     pub fn new(mesh: &TriMesh) -> Self {
         let mut tris: Vec<Tri> = (0..mesh.face_count())
-            .map(|f| Tri {
-                corners: mesh.corners(f).map(|p| Point3::new(p[0], p[1], p[2])),
-                face: f,
-                node: 0,
-            })
+            .map(|f| Tri::new(mesh, f, f))
             .collect();
         let bvh = Bvh::build(&mut tris);
         Self { tris, bvh }
@@ -88,7 +61,7 @@ impl SurfaceIndex {
             .expect("a validated mesh has at least one face");
         let (c, barycentric) = closest_on_triangle(&q, &tri.corners);
         SurfacePoint {
-            face: tri.face,
+            face: tri.data,
             barycentric,
             distance: (c - q).norm(),
         }

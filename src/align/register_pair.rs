@@ -92,7 +92,7 @@ pub struct Registration {
 const REFINED: usize = 4;
 /// Iterations of the coarse pass: ICP from a principal-frame start settles in a few steps;
 /// the coarse pass only ranks the starts.
-pub(crate) const COARSE_ITERATIONS: usize = 6;
+const COARSE_ITERATIONS: usize = 6;
 /// Two rotations are "the same pose" within this angle (degrees): ICP runs from different
 /// starts that reach one minimum end within a degree or two of each other; distinct
 /// symmetric poses of real shapes are 90° or 180° apart.
@@ -147,23 +147,9 @@ pub(crate) fn register_prepared(
     options: &RegisterOptions,
 ) -> Registration {
     let starts = starting_rotations(&s.moments.frame, &t.moments.frame);
-    let coarse_n = COARSE_SAMPLES.min(options.samples);
     let coarse: Vec<Pose> = starts
         .par_iter()
-        .map(|r| {
-            icp(
-                s,
-                t,
-                coarse_n,
-                Pose {
-                    rotation: *r,
-                    translation: Vector3::zeros(),
-                    residual: f64::INFINITY,
-                },
-                COARSE_ITERATIONS,
-                options.trim,
-            )
-        })
+        .map(|r| coarse_icp(s, t, r, options))
         .collect();
     let mut order: Vec<usize> = (0..coarse.len()).collect();
     order.sort_by(|&a, &b| coarse[a].residual.total_cmp(&coarse[b].residual));
@@ -248,11 +234,35 @@ pub(crate) fn to_similarity(s: &Prepared, t: &Prepared, p: &Pose) -> Similarity 
     }
 }
 
-fn angle(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
+/// The coarse pass from one start rotation: a few ICP steps on a subsample, enough to rank the
+/// starts.
+pub(crate) fn coarse_icp(
+    s: &Prepared,
+    t: &Prepared,
+    start: &Matrix3<f64>,
+    options: &RegisterOptions,
+) -> Pose {
+    icp(
+        s,
+        t,
+        COARSE_SAMPLES.min(options.samples),
+        Pose {
+            rotation: *start,
+            translation: Vector3::zeros(),
+            residual: f64::INFINITY,
+        },
+        COARSE_ITERATIONS,
+        options.trim,
+    )
+}
+
+/// The angle (degrees) between two rotations.
+pub(crate) fn angle(a: &Matrix3<f64>, b: &Matrix3<f64>) -> f64 {
     rotation_angle(&to_rows(a), &to_rows(b))
 }
 
-fn to_rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
+/// A rotation's rows, as [`rotation_angle`] and [`Similarity`] take them.
+pub(crate) fn to_rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     [
         [m[(0, 0)], m[(0, 1)], m[(0, 2)]],
         [m[(1, 0)], m[(1, 1)], m[(1, 2)]],

@@ -1,5 +1,6 @@
 //! [`Similarity`]: a rotation, a uniform scale and a translation, `x ↦ s R x + t`.
 
+use rand_chacha::rand_core::Rng;
 use serde::{Deserialize, Serialize};
 
 /// A similarity transform `x ↦ scale · rotation · x + translation` of 3D points.
@@ -34,6 +35,48 @@ impl Similarity {
             rotation: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
             scale: 1.0,
             translation: [0.0; 3],
+        }
+    }
+
+    /// A random similarity: a uniformly distributed rotation (a unit quaternion from four
+    /// normal draws, Box–Muller), a scale in 0.5–2 (log-uniform) and a translation within ±10
+    /// on each axis; seeded `rng`, same draws, same similarity. For moving a collection at
+    /// random to test or benchmark the alignment.
+    pub fn random<R: Rng + ?Sized>(rng: &mut R) -> Self {
+        // A uniform draw in [0, 1) from the top 53 bits: every value a double holds exactly.
+        let mut unit = || (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        let mut q = [0.0f64; 4];
+        for k in 0..2 {
+            let (u1, u2) = (unit().max(1e-12), unit());
+            let r = (-2.0 * u1.ln()).sqrt();
+            q[2 * k] = r * (std::f64::consts::TAU * u2).cos();
+            q[2 * k + 1] = r * (std::f64::consts::TAU * u2).sin();
+        }
+        let n = q.iter().map(|x| x * x).sum::<f64>().sqrt();
+        let [w, x, y, z] = q.map(|v| v / n);
+        let rotation = [
+            [
+                1.0 - 2.0 * (y * y + z * z),
+                2.0 * (x * y - w * z),
+                2.0 * (x * z + w * y),
+            ],
+            [
+                2.0 * (x * y + w * z),
+                1.0 - 2.0 * (x * x + z * z),
+                2.0 * (y * z - w * x),
+            ],
+            [
+                2.0 * (x * z - w * y),
+                2.0 * (y * z + w * x),
+                1.0 - 2.0 * (x * x + y * y),
+            ],
+        ];
+        let scale = 0.5 * 4f64.powf(unit());
+        let translation = [0, 1, 2].map(|_| 20.0 * unit() - 10.0);
+        Self {
+            rotation,
+            scale,
+            translation,
         }
     }
 

@@ -5,9 +5,8 @@
 //! CAD-like meshes made of many closed parts, where the Laplacian spectrum does not.
 
 use super::{FeatureColumns, FeatureError};
-use crate::mesh::{TriMesh, connected_components};
-use bvh::aabb::{Aabb, Bounded};
-use bvh::bounding_hierarchy::BHShape;
+use crate::mesh::{BvhTriangle, TriMesh, connected_components};
+use bvh::aabb::Bounded;
 use bvh::bvh::Bvh;
 use bvh::ray::Ray;
 use nalgebra::{Point3, Vector3};
@@ -36,29 +35,8 @@ impl Default for SdfOptions {
     }
 }
 
-struct Tri {
-    corners: [Point3<f64>; 3],
-    normal: Vector3<f64>,
-    node: usize,
-}
-
-impl Bounded<f64, 3> for Tri {
-    fn aabb(&self) -> Aabb<f64, 3> {
-        Aabb::empty()
-            .grow(&self.corners[0])
-            .grow(&self.corners[1])
-            .grow(&self.corners[2])
-    }
-}
-
-impl BHShape<f64, 3> for Tri {
-    fn set_bh_node_index(&mut self, i: usize) {
-        self.node = i;
-    }
-    fn bh_node_index(&self) -> usize {
-        self.node
-    }
-}
+/// A triangle of the hierarchy, with its face's outward normal.
+type Tri = BvhTriangle<Vector3<f64>>;
 
 /// Two-sided Möller–Trumbore: the distance along `dir` to the triangle, if hit at `t > eps`.
 fn hit_distance(o: &Point3<f64>, dir: &Vector3<f64>, t: &Tri, eps: f64) -> Option<f64> {
@@ -213,13 +191,12 @@ fn raw_sdf(mesh: &TriMesh, rays: usize, half: f64) -> Vec<f64> {
     let face_normals = mesh.face_normals();
     let mut tris: Vec<Tri> = (0..mesh.face_count())
         .map(|f| {
-            let c = mesh.corners(f);
             let n = face_normals[f];
-            Tri {
-                corners: c.map(|p| Point3::new(p[0], p[1], p[2])),
-                normal: Vector3::new(n[0], n[1], n[2]) * sign(mesh.faces()[f][0] as usize),
-                node: 0,
-            }
+            Tri::new(
+                mesh,
+                f,
+                Vector3::new(n[0], n[1], n[2]) * sign(mesh.faces()[f][0] as usize),
+            )
         })
         .collect();
     let bvh = Bvh::build(&mut tris);
@@ -278,7 +255,7 @@ fn nearest_hit(
             break;
         }
         // Only walls seen from the inside count: the hit face's outward normal goes along the ray.
-        if tri.normal.dot(dir) <= 0.0 {
+        if tri.data.dot(dir) <= 0.0 {
             continue;
         }
         if let Some(t) = hit_distance(origin, dir, tri, eps)

@@ -130,6 +130,29 @@ pub struct RegionTuple {
     pub leftover: bool,
 }
 
+impl RegionTuple {
+    /// A tuple given from outside the solver (regions drawn or read, not co-segmented): no
+    /// sweeps, a fixed point, objective 0, full confidence, no cycle measure, not the leftovers.
+    ///
+    /// ```
+    /// let t = coseg::graph::RegionTuple::given(vec![vec![0, 1], vec![2]], vec![0.5, 0.25]);
+    /// assert!(t.converged && !t.leftover && t.confidence == 1.0);
+    /// ```
+    pub fn given(regions: Vec<Vec<u32>>, area_fractions: Vec<f64>) -> Self {
+        Self {
+            regions,
+            area_fractions,
+            sweeps: 0,
+            converged: true,
+            cycled: false,
+            objective: 0.0,
+            confidence: 1.0,
+            cycle_consistency: None,
+            leftover: false,
+        }
+    }
+}
+
 /// The co-segmentation of a collection.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Cosegmentation {

@@ -10,10 +10,12 @@
 
 use thiserror::Error;
 
+mod bvh_triangle;
 pub mod io;
 mod topology;
 mod validate;
 
+pub(crate) use bvh_triangle::BvhTriangle;
 pub use io::{
     MeshFormat, PlyVertexProperty, read_mesh, read_mesh_from_bytes, read_mesh_with_report,
     write_atomic, write_mesh,

@@ -9,7 +9,7 @@
 
 use super::{OutputError, region_colors};
 use crate::mesh::write_atomic;
-use crate::render::{RenderShape, canonical_frame};
+use crate::render::{RenderShape, canonical_frame, labels_present};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -38,12 +38,7 @@ fn base64(bytes: &[u8]) -> String {
 
 /// The JSON data block of the page: shapes (name, confidence, base64 arrays) and parts.
 fn page_data(shapes: &[RenderShape<'_>], part_names: Option<&[String]>) -> serde_json::Value {
-    let mut labels: Vec<i32> = shapes
-        .iter()
-        .flat_map(|s| s.labels.iter().copied())
-        .collect();
-    labels.sort_unstable();
-    labels.dedup();
+    let labels = labels_present(shapes);
     let parts: Vec<serde_json::Value> = labels
         .iter()
         .zip(region_colors(&labels))

@@ -502,17 +502,7 @@ mod tests {
                 .collect();
             TriMesh::new(p, f).unwrap()
         };
-        let tuple = |r: Vec<u32>| RegionTuple {
-            area_fractions: vec![0.0],
-            regions: vec![r],
-            sweeps: 0,
-            converged: true,
-            cycled: false,
-            objective: 0.0,
-            confidence: 1.0,
-            cycle_consistency: None,
-            leftover: false,
-        };
+        let tuple = |r: Vec<u32>| RegionTuple::given(vec![r], vec![0.0]);
         let coseg = Cosegmentation {
             names: vec!["s".into()],
             vertices: vec![10],

@@ -1,6 +1,6 @@
 //! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
 
-use super::held_out::held_out_routes_cached;
+use super::held_out::{HeldOutInputs, held_out_routes_cached};
 use super::rigid_route::rigid_route_cached;
 use super::{
     FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
@@ -250,17 +250,17 @@ pub fn fuse_propagation(
         report.routes.push((Route::Rigid, rigid));
     }
     let names: Vec<Route> = report.routes.iter().map(|(r, _)| *r).collect();
-    report.held_out_runs = held_out_routes_cached(
+    let held_out = HeldOutInputs {
         graph,
         meshes,
         annotations,
         smoothers,
         propagate,
-        &names,
+        routes: &names,
         segmentation,
-        options.affine,
-        &propagation.rigid,
-    )?;
+        affine: options.affine,
+    };
+    report.held_out_runs = held_out_routes_cached(&held_out, &propagation.rigid)?;
     report.held_out = report.held_out_runs.as_ref().map(|h| h.accuracy.clone());
     let refs: Vec<&RouteLabels> = report.routes.iter().map(|(_, r)| r).collect();
     // The band affinity and the parts route fail together where both read the intrinsic

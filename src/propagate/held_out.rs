@@ -7,6 +7,28 @@ use crate::graph::{Cosegmentation, ShapeGraph};
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
 
+/// What the held-out runs read: the propagation's inputs as the band-affinity solve used
+/// them, and the routes to score.
+#[derive(Debug, Clone, Copy)]
+pub struct HeldOutInputs<'a> {
+    /// The shape graph of the collection.
+    pub graph: &'a ShapeGraph,
+    /// The meshes (graph order; the rigid route reads them).
+    pub meshes: &'a [TriMesh],
+    /// Per shape (graph order): its labels, `None` for a target.
+    pub annotations: &'a [Option<Vec<i32>>],
+    /// The heat smoothers of the band-affinity solve, if it used them.
+    pub smoothers: Option<&'a [HeatSmoother]>,
+    /// The band-affinity solve's options.
+    pub propagate: &'a PropagateOptions,
+    /// The routes to score, in the order of the answer.
+    pub routes: &'a [Route],
+    /// The parts route's co-segmentation (`None`: the parts route gives no labels).
+    pub segmentation: Option<&'a Cosegmentation>,
+    /// Whether the rigid route takes its affine step.
+    pub affine: bool,
+}
+
 /// Each route's accuracy on the sources, measured against the user's own labels: every source
 /// in turn is left unlabelled, each route carries the other sources' labels to it, and the
 /// area share of its annotated vertices that receive their own label is the route's score
@@ -18,39 +40,16 @@ use crate::spectral::HeatSmoother;
 /// independently, which two routes reading the same intrinsic features do not (both confuse a
 /// part with its mirror image).
 ///
-/// Inputs: `graph`, `meshes`, `annotations` (#shapes, graph order), `smoothers` and
-/// `propagate` as the band-affinity solve used them, `routes` (the routes to score, in the
-/// order of the answer), `segmentation` (the parts route's co-segmentation), `affine` (the
-/// rigid route's affine step). Output: per route, its mean held-out accuracy in `[0, 1]`;
-/// `None` with fewer than two annotated shapes (nothing to hold out from).
+/// Output: per route of `inputs.routes`, its mean held-out accuracy in `[0, 1]`; `None` with
+/// fewer than two annotated shapes (nothing to hold out from).
 ///
 /// Errors: those of [`propagate_labels`] other than a held-out run left without labels
 /// (a source whose labels no other source has is skipped).
 ///
 /// Known issue: each source is reached from one source fewer than the targets are, so the
 /// scores are a little below the routes' accuracy on the targets, for every route alike.
-#[allow(clippy::too_many_arguments)]
-pub fn held_out_accuracy(
-    graph: &ShapeGraph,
-    meshes: &[TriMesh],
-    annotations: &[Option<Vec<i32>>],
-    smoothers: Option<&[HeatSmoother]>,
-    propagate: &PropagateOptions,
-    routes: &[Route],
-    segmentation: Option<&Cosegmentation>,
-    affine: bool,
-) -> Result<Option<Vec<f64>>, PropagateError> {
-    Ok(held_out_routes(
-        graph,
-        meshes,
-        annotations,
-        smoothers,
-        propagate,
-        routes,
-        segmentation,
-        affine,
-    )?
-    .map(|h| h.accuracy))
+pub fn held_out_accuracy(inputs: &HeldOutInputs) -> Result<Option<Vec<f64>>, PropagateError> {
+    Ok(held_out_routes(inputs)?.map(|h| h.accuracy))
 }
 
 /// Every route's labels on every source, each carried to from the other sources, and the
@@ -75,18 +74,17 @@ pub struct HeldOutRoutes {
 
 /// [`held_out_accuracy`] with every held-out run's labels ([`HeldOutRoutes`]); same inputs
 /// and errors.
-#[allow(clippy::too_many_arguments)]
-pub fn held_out_routes(
-    graph: &ShapeGraph,
-    meshes: &[TriMesh],
-    annotations: &[Option<Vec<i32>>],
-    smoothers: Option<&[HeatSmoother]>,
-    propagate: &PropagateOptions,
-    routes: &[Route],
-    segmentation: Option<&Cosegmentation>,
-    affine: bool,
+pub fn held_out_routes(inputs: &HeldOutInputs) -> Result<Option<HeldOutRoutes>, PropagateError> {
+    held_out_routes_cached(inputs, &RigidCache::default())
+}
+
+/// [`held_out_routes`] with the rigid route's registrations kept in `rigid` (the fusion
+/// shares its propagation's cache, whose pairs of sources the held-out runs need).
+pub(crate) fn held_out_routes_cached(
+    inputs: &HeldOutInputs,
+    rigid: &RigidCache,
 ) -> Result<Option<HeldOutRoutes>, PropagateError> {
-    held_out_routes_cached(
+    let HeldOutInputs {
         graph,
         meshes,
         annotations,
@@ -95,24 +93,7 @@ pub fn held_out_routes(
         routes,
         segmentation,
         affine,
-        &RigidCache::default(),
-    )
-}
-
-/// [`held_out_routes`] with the rigid route's registrations kept in `rigid` (the fusion
-/// shares its propagation's cache, whose pairs of sources the held-out runs need).
-#[allow(clippy::too_many_arguments)]
-pub(crate) fn held_out_routes_cached(
-    graph: &ShapeGraph,
-    meshes: &[TriMesh],
-    annotations: &[Option<Vec<i32>>],
-    smoothers: Option<&[HeatSmoother]>,
-    propagate: &PropagateOptions,
-    routes: &[Route],
-    segmentation: Option<&Cosegmentation>,
-    affine: bool,
-    rigid: &RigidCache,
-) -> Result<Option<HeldOutRoutes>, PropagateError> {
+    } = *inputs;
     let n = annotations.len();
     let sources: Vec<usize> = (0..n)
         .filter(|&i| {

@@ -39,7 +39,7 @@ pub use collection::{
 };
 pub use fuse_propagation::{CollectionParts, FusionReport, RouteOptions, fuse_propagation};
 pub use fuse_routes::{FusedRoutes, Route, RouteLabels, fuse_routes, fuse_routes_with};
-pub use held_out::{HeldOutRoutes, held_out_accuracy, held_out_routes};
+pub use held_out::{HeldOutInputs, HeldOutRoutes, held_out_accuracy, held_out_routes};
 pub use map_step::{MapStepOptions, MapStepReport, map_step};
 pub use options::PropagateOptions;
 pub use part_scores::PartScore;

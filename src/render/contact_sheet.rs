@@ -18,6 +18,18 @@ pub struct RenderShape<'a> {
     pub confidence: Option<f64>,
 }
 
+/// Every label of `shapes` (the unlabelled `-1` too), ascending, once each: the legend's
+/// entries, and the viewer's.
+pub(crate) fn labels_present(shapes: &[RenderShape<'_>]) -> Vec<i32> {
+    let mut labels: Vec<i32> = shapes
+        .iter()
+        .flat_map(|s| s.labels.iter().copied())
+        .collect();
+    labels.sort_unstable();
+    labels.dedup();
+    labels
+}
+
 /// Layout of the pictures.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
@@ -188,12 +200,7 @@ pub fn render_sheet(
     let rows = n.div_ceil(cols);
     let cell_h = opts.cell_size + opts.caption_height();
     let width = cols as u32 * opts.cell_size;
-    let mut labels: Vec<i32> = shapes
-        .iter()
-        .flat_map(|s| s.labels.iter().copied())
-        .collect();
-    labels.sort_unstable();
-    labels.dedup();
+    let labels = labels_present(shapes);
     let mut img = RgbImage::filled(1, 1, opts.background);
     let legend_h = if opts.legend {
         legend(&mut img, 0, width, &labels, part_names, opts, true)

@@ -23,6 +23,7 @@ mod rasterise;
 mod region_colors;
 
 pub use canonical_view::{ViewFrame, canonical_frame};
+pub(crate) use contact_sheet::labels_present;
 pub use contact_sheet::{RenderOptions, RenderShape, render_shape, render_sheet, write_pictures};
 pub use font::{draw_text, text_width};
 pub use png_io::{encode_png, write_png};

@@ -98,6 +98,41 @@ fn project_out(basis: MatRef<'_, f64>, mut w: MatMut<'_, f64>, par: Par) -> Mat<
     c
 }
 
+/// The Euclidean norm of column `i` of `w`.
+fn column_norm(w: MatRef<'_, f64>, i: usize) -> f64 {
+    let c = col(w, i);
+    dot(c, c).sqrt()
+}
+
+/// Removes from column `i` of `w` its component along column `l` (not normalised: the
+/// caller's columns before `i` are); returns that component's coefficient.
+fn remove_component(mut w: MatMut<'_, f64>, l: usize, i: usize) -> f64 {
+    let ql = col(w.as_ref(), l).to_vec();
+    let wi = col_mut(w.rb_mut(), i);
+    let c = dot(&ql, wi);
+    for (x, q) in wi.iter_mut().zip(&ql) {
+        *x -= c * q;
+    }
+    c
+}
+
+/// Projects column `i` of `w` off the columns of `first`, then of `second`, then off `w`'s
+/// columns before `i` one by one (the order is part of the result at rounding level).
+fn project_column(
+    first: MatRef<'_, f64>,
+    second: MatRef<'_, f64>,
+    mut w: MatMut<'_, f64>,
+    i: usize,
+    par: Par,
+) {
+    let mut wi = w.rb_mut().subcols_mut(i, 1);
+    project_out(first, wi.rb_mut(), par);
+    project_out(second, wi.rb_mut(), par);
+    for l in 0..i {
+        remove_component(w.rb_mut(), l, i);
+    }
+}
+
 /// Orthonormalises the columns of `w` in place (two Gram–Schmidt passes inside the block),
 /// keeping them orthogonal to `v` and `null`; returns the upper-triangular `R` with
 /// `W_in = Q R` (after the caller's projection). Columns whose norm collapses (the Krylov space
@@ -113,40 +148,17 @@ fn orthonormalise_block(
     let b = w.ncols();
     let mut r = Mat::<f64>::zeros(b, b);
     for i in 0..b {
-        let before = {
-            let c = col(w.as_ref(), i);
-            dot(c, c).sqrt()
-        };
+        let before = column_norm(w.as_ref(), i);
         for _pass in 0..2 {
             for l in 0..i {
-                let ql = col(w.as_ref(), l).to_vec();
-                let wi = col_mut(w.rb_mut(), i);
-                let c = dot(&ql, wi);
-                for (x, q) in wi.iter_mut().zip(&ql) {
-                    *x -= c * q;
-                }
-                r[(l, i)] += c;
+                r[(l, i)] += remove_component(w.rb_mut(), l, i);
             }
         }
-        let mut norm = {
-            let c = col(w.as_ref(), i);
-            dot(c, c).sqrt()
-        };
+        let mut norm = column_norm(w.as_ref(), i);
         if norm < 1e-3 * before {
             // Heavy cancellation: orthogonality to the basis may be lost, so redo it.
-            let mut wi = w.rb_mut().subcols_mut(i, 1);
-            project_out(v, wi.rb_mut(), par);
-            project_out(null, wi.rb_mut(), par);
-            for l in 0..i {
-                let ql = col(w.as_ref(), l).to_vec();
-                let wi = col_mut(w.rb_mut(), i);
-                let c = dot(&ql, wi);
-                for (x, q) in wi.iter_mut().zip(&ql) {
-                    *x -= c * q;
-                }
-            }
-            let c = col(w.as_ref(), i);
-            norm = dot(c, c).sqrt();
+            project_column(v, null, w.rb_mut(), i, par);
+            norm = column_norm(w.as_ref(), i);
         }
         let scale = norms_in[i].max(before);
         if norm.is_nan() || norm <= 1e-13 * scale || !norm.is_finite() {
@@ -160,20 +172,9 @@ fn orthonormalise_block(
                     }
                 }
                 for _pass in 0..2 {
-                    let mut wi = w.rb_mut().subcols_mut(i, 1);
-                    project_out(null, wi.rb_mut(), par);
-                    project_out(v, wi.rb_mut(), par);
-                    for l in 0..i {
-                        let ql = col(w.as_ref(), l).to_vec();
-                        let wi = col_mut(w.rb_mut(), i);
-                        let c = dot(&ql, wi);
-                        for (x, q) in wi.iter_mut().zip(&ql) {
-                            *x -= c * q;
-                        }
-                    }
+                    project_column(null, v, w.rb_mut(), i, par);
                 }
-                let c = col(w.as_ref(), i);
-                norm = dot(c, c).sqrt();
+                norm = column_norm(w.as_ref(), i);
                 if norm > 1e-8 || attempt == 3 {
                     break;
                 }
