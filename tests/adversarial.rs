@@ -12,10 +12,11 @@ mod common;
 use common::adversarial::{
     Case, base_sphere, corpus, with_collinear_slivers, with_surface_debris, write_case,
 };
+use common::cli::coseg;
 use common::generate::collections_dir;
 use coseg::mesh::{TriMesh, read_mesh, write_mesh};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::process::Output;
 
 /// A fresh, empty scratch folder `name` under Cargo's per-target temporary directory.
 fn scratch(name: &str) -> PathBuf {
@@ -27,13 +28,6 @@ fn scratch(name: &str) -> PathBuf {
     }
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn coseg<S: AsRef<std::ffi::OsStr>>(args: &[S]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args(args)
-        .output()
-        .expect("the coseg binary runs")
 }
 
 fn text(o: &Output) -> (String, String) {

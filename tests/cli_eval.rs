@@ -1,7 +1,9 @@
 //! `coseg eval` on a hand-made result folder: the table, the JSON and `.seg` ground truth.
 
+mod common;
+
+use common::cli::{arg, coseg, coseg_ok, text};
 use coseg::mesh::{TriMesh, write_mesh};
-use std::process::Command;
 
 #[test]
 fn eval_scores_a_result_folder_against_vertex_and_face_ground_truth() {
@@ -25,23 +27,11 @@ fn eval_scores_a_result_folder_against_vertex_and_face_ground_truth() {
     // between 1 and 2 and take 1; so b's vertex labels are 1, 1, 1, 2.
     std::fs::write(truth.join("b.seg"), "1\n2\n").unwrap();
     let json = dir.path().join("scores.json");
-    let out = Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args([
-            "eval",
-            result.to_str().unwrap(),
-            "--truth",
-            truth.to_str().unwrap(),
-        ])
-        .args(["--map", "identity", "--json", json.to_str().unwrap()])
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let mut args = vec!["eval", arg(&result), "--truth", arg(&truth)];
+    args.extend(["--map", "identity", "--json", arg(&json)]);
+    let out = coseg(&args);
+    let stdout = text(&out.stdout);
+    assert_eq!(out.status.code(), Some(0), "{stdout}{}", text(&out.stderr));
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     // Region 4 → part 1 (3 votes), region 9 → part 2 (3 of 5 votes).
@@ -68,39 +58,18 @@ fn eval_scores_a_propagation_folder_and_leaves_the_source_out() {
     let goblets = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("collections/goblets");
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("out");
-    let run = Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .arg("propagate")
-        .arg(&goblets)
-        .arg("--labels")
-        .arg(goblets.join("goblets_00.labels.txt"))
-        .arg("-o")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let labels = goblets.join("goblets_00.labels.txt");
+    let mut args = vec!["propagate", arg(&goblets), "--labels", arg(&labels)];
+    args.extend(["-o", arg(&out)]);
+    coseg_ok(&args);
     for f in ["preview.png", "index.html", "goblets_02.png"] {
         assert!(out.join(f).is_file(), "{f} missing");
     }
     let json = dir.path().join("scores.json");
-    let eval = Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .arg("eval")
-        .arg(&out)
-        .arg("--truth")
-        .arg(&goblets)
-        .arg("--json")
-        .arg(&json)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&eval.stdout);
-    assert!(
-        eval.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&eval.stderr)
-    );
+    let mut args = vec!["eval", arg(&out), "--truth", arg(&goblets)];
+    args.extend(["--json", arg(&json)]);
+    let eval = coseg_ok(&args);
+    let stdout = text(&eval.stdout);
     let v: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
     assert_eq!(v["kind"], "labels");

@@ -2,21 +2,10 @@
 
 mod common;
 
+use common::cli::{coseg, text};
 use common::mesh::{grid, tetrahedron};
 use coseg::mesh::{read_mesh, write_mesh};
 use std::path::Path;
-use std::process::{Command, Output};
-
-fn coseg(args: &[&Path]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args(args)
-        .output()
-        .expect("run coseg")
-}
-
-fn text(bytes: &[u8]) -> String {
-    String::from_utf8_lossy(bytes).into_owned()
-}
 
 #[test]
 fn info_on_good_files_exits_0_and_prints_counts_and_warnings() {

@@ -3,37 +3,32 @@
 
 mod common;
 
+use common::cli::{FAST_PIPELINE, arg as s, coseg, text};
 use common::features::{blob, similarity};
 use coseg::mesh::write_mesh;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-/// Small pipeline settings so that debug builds finish in seconds.
-const FAST: &[&str] = &[
-    "--eigenpairs",
-    "20",
-    "--hks",
-    "6",
-    "--wks",
-    "6",
-    "--curvature",
-    "6",
-    "--bands",
-    "6",
-    "--regions",
-    "3",
-];
+/// [`FAST_PIPELINE`] and 3 regions.
+const FAST: [&str; 12] = {
+    let [a, b, c, d, e, f, g, h, i, j] = FAST_PIPELINE;
+    [a, b, c, d, e, f, g, h, i, j, "--regions", "3"]
+};
 
-fn coseg(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args(args)
-        .output()
-        .expect("run coseg")
+/// `dir/in` holding [`shapes`] `(n, level)`; the folder.
+fn input_folder(dir: &Path, n: usize, level: usize) -> PathBuf {
+    let input = dir.join("in");
+    std::fs::create_dir(&input).unwrap();
+    shapes(&input, n, level);
+    input
 }
 
-fn text(b: &[u8]) -> String {
-    String::from_utf8_lossy(b).into_owned()
+/// `coseg segment INPUT -o OUT -q --no-pictures FLAGS`.
+fn quiet_segment(input: &Path, out: &Path, flags: &[&str]) -> Output {
+    let mut args = vec!["segment", s(input), "-o", s(out), "-q", "--no-pictures"];
+    args.extend(flags);
+    coseg(&args)
 }
 
 /// `n` smooth blobs (level-`level` icospheres, 10·4^level + 2 vertices) in `dir`, as OBJ, OFF
@@ -44,10 +39,6 @@ fn shapes(dir: &Path, n: usize, level: usize) {
         let mesh = similarity(&blob(level), 1.0 + 0.1 * i as f64);
         write_mesh(dir.join(format!("s{i}.{}", ext[i % 3])), &mesh, &[]).unwrap();
     }
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
 }
 
 /// `coseg -q pair` between the first two of [`shapes`] in `dir`, writing to `out`, with no
@@ -79,9 +70,7 @@ fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
 #[test]
 fn broken_file_is_reported_and_skipped_with_exit_3_and_strict_fails() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 3, 2);
+    let input = input_folder(dir.path(), 3, 2);
     std::fs::write(input.join("broken.off"), "OFF\n4 4 0\n0 0 0\n").unwrap();
     std::fs::write(input.join("notes.txt"), "not a mesh").unwrap();
     let out = dir.path().join("out");
@@ -124,15 +113,14 @@ fn broken_file_is_reported_and_skipped_with_exit_3_and_strict_fails() {
 /// `coseg segment -q --no-pictures --parts auto` with `extra` flags on two small shapes made
 /// in `dir`; the run and its output folder.
 fn segment_parts_auto(dir: &Path, extra: &[&str]) -> (Output, std::path::PathBuf) {
-    let input = dir.join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 2, 2);
+    let input = input_folder(dir, 2, 2);
     let out = dir.join("out");
-    let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
-    args.extend(FAST);
-    args.extend(["--parts", "auto"]);
-    args.extend(extra);
-    (coseg(&args), out)
+    let run = quiet_segment(
+        &input,
+        &out,
+        &[&FAST[..], &["--parts", "auto"], extra].concat(),
+    );
+    (run, out)
 }
 
 /// `--parts auto` printed its "parts: …" line under `--quiet`.
@@ -194,16 +182,14 @@ fn parts_records_mirror_pairs() {
 #[test]
 fn refine_sizes_is_recorded_and_checked() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 2, 2);
+    let input = input_folder(dir.path(), 2, 2);
     let run_with = |name: &str, extra: &[&str]| {
         let out = dir.path().join(name);
-        let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
-        args.extend(FAST);
-        args.extend(["--parts", "auto"]);
-        args.extend(extra);
-        let run = coseg(&args);
+        let run = quiet_segment(
+            &input,
+            &out,
+            &[&FAST[..], &["--parts", "auto"], extra].concat(),
+        );
         (run, out)
     };
     let summary = |out: &Path| std::fs::read_to_string(out.join("summary.json")).unwrap();
@@ -235,16 +221,14 @@ fn refine_sizes_is_recorded_and_checked() {
 #[test]
 fn parts_from_geometry_is_recorded_and_checked() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 3, 2);
+    let input = input_folder(dir.path(), 3, 2);
     let run_with = |name: &str, extra: &[&str]| {
         let out = dir.path().join(name);
-        let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
         // FAST without its `--regions 3`: the regions are set here.
-        args.extend(&FAST[..FAST.len() - 2]);
-        args.extend(extra);
-        (coseg(&args), out)
+        (
+            quiet_segment(&input, &out, &[&FAST_PIPELINE[..], extra].concat()),
+            out,
+        )
     };
     let (run, out) = run_with(
         "t",
@@ -357,9 +341,7 @@ fn regression_starts_with_parts_was_silently_ignored() {
 #[test]
 fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 2, 2);
+    let input = input_folder(dir.path(), 2, 2);
     let out = dir.path().join("out");
     let mut args = vec![
         "segment",
@@ -378,26 +360,11 @@ fn quiet_prints_nothing_on_success_and_no_pictures_writes_none() {
     assert!(!out.join("preview.png").exists() && !out.join("index.html").exists());
 
     let pair_out = dir.path().join("pair");
-    let run = coseg(&[
-        "-q",
-        "pair",
-        s(&input.join("s0.obj")),
-        s(&input.join("s1.off")),
-        "-o",
-        s(&pair_out),
-        "--eigenpairs",
-        "20",
-        "--hks",
-        "6",
-        "--wks",
-        "6",
-        "--curvature",
-        "6",
-        "--bands",
-        "6",
-        "--pairs",
-        "3",
-    ]);
+    let (s0, s1) = (input.join("s0.obj"), input.join("s1.off"));
+    let mut args = vec!["-q", "pair", s(&s0), s(&s1), "-o", s(&pair_out)];
+    args.extend(FAST_PIPELINE);
+    args.extend(["--pairs", "3"]);
+    let run = coseg(&args);
     assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
     assert!(
         run.stdout.is_empty() && run.stderr.is_empty(),
@@ -632,15 +599,10 @@ fn help_shows_an_example_for_every_subcommand_and_the_shared_flags() {
 #[test]
 fn segment_starts_records_the_choice_and_keeps_that_starts_regions() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 3, 2);
+    let input = input_folder(dir.path(), 3, 2);
     let run_with = |name: &str, extra: &[&str]| {
         let out = dir.path().join(name);
-        let mut args = vec!["segment", s(&input), "-o", s(&out), "-q", "--no-pictures"];
-        args.extend(FAST);
-        args.extend(extra);
-        let run = coseg(&args);
+        let run = quiet_segment(&input, &out, &[&FAST[..], extra].concat());
         assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
         let summary: serde_json::Value =
             serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
@@ -692,9 +654,7 @@ fn segment_starts_records_the_choice_and_keeps_that_starts_regions() {
 #[test]
 fn warm_runs_write_the_cold_runs_files_byte_for_byte() {
     let dir = tempfile::tempdir().unwrap();
-    let input = dir.path().join("in");
-    std::fs::create_dir(&input).unwrap();
-    shapes(&input, 3, 3);
+    let input = input_folder(dir.path(), 3, 3);
     let cache = dir.path().join("cache");
     let run = |threads: &str, cmd: &[&str], out: &str, cache: Option<&Path>| {
         let out = dir.path().join(out);

@@ -5,25 +5,11 @@
 
 mod common;
 
-use common::generate::collections_dir;
+use common::generate::goblets;
 use common::studio::{Server, request, start};
 use std::net::{SocketAddr, TcpStream, UdpSocket};
 use std::path::Path;
 use std::time::Duration;
-
-fn goblets(dir: &Path) -> std::path::PathBuf {
-    let folder = dir.join("shapes");
-    std::fs::create_dir_all(&folder).unwrap();
-    for i in 0..3 {
-        let name = format!("goblets_{i:02}.obj");
-        std::fs::copy(
-            collections_dir().join("goblets").join(&name),
-            folder.join(&name),
-        )
-        .unwrap();
-    }
-    folder
-}
 
 fn state(s: &Server) -> serde_json::Value {
     let (code, body) = request(
@@ -43,7 +29,7 @@ type Case<'a> = (&'a str, &'a str, Vec<(&'a str, &'a str)>, &'a str, u16);
 #[test]
 fn studio_refuses_requests_without_the_token_from_elsewhere_or_outside_the_folder() {
     let dir = tempfile::tempdir().unwrap();
-    let folder = goblets(dir.path());
+    let folder = goblets(dir.path(), 3);
     let s = start(&folder, &dir.path().join("cache"));
     let before = state(&s);
     let add = r#"{"op":"add","name":"bowl"}"#;
@@ -236,7 +222,7 @@ fn studio_is_not_reachable_on_a_non_loopback_address() {
         }
     };
     let dir = tempfile::tempdir().unwrap();
-    let folder = goblets(dir.path());
+    let folder = goblets(dir.path(), 3);
     let s = start(&folder, &dir.path().join("cache"));
     assert_eq!(
         request(s.port, "GET", "/api/state", &[], "").0,

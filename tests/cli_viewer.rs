@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::cli::{FAST_PIPELINE, arg, coseg, text};
 use common::features::{blob, similarity};
 use coseg::mesh::write_mesh;
 use std::path::{Path, PathBuf};
@@ -59,32 +60,10 @@ fn viewer_page_renders_in_headless_chromium_without_console_errors() {
         write_mesh(input.join(format!("blob{i}.obj")), &mesh, &[]).unwrap();
     }
     let out = dir.path().join("out");
-    let run = Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args([
-            "segment",
-            input.to_str().unwrap(),
-            "-o",
-            out.to_str().unwrap(),
-        ])
-        .args([
-            "--eigenpairs",
-            "20",
-            "--hks",
-            "6",
-            "--wks",
-            "6",
-            "--curvature",
-            "6",
-        ])
-        .args(["--bands", "6", "--regions", "3"])
-        .output()
-        .unwrap();
-    assert_eq!(
-        run.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let mut args = vec!["segment", arg(&input), "-o", arg(&out), "--regions", "3"];
+    args.extend(FAST_PIPELINE);
+    let run = coseg(&args);
+    assert_eq!(run.status.code(), Some(0), "{}", text(&run.stderr));
     let page = out.join("index.html");
     let html = std::fs::read_to_string(&page).unwrap();
     assert!(

@@ -4,11 +4,11 @@
 
 mod common;
 
+use common::cli::{arg, coseg_ok};
 use common::generate::collections_dir;
 use coseg::evaluate::{GroundTruth, ShapeParts, part_coverage, part_purity, read_labels};
 use coseg::mesh::read_mesh;
 use std::path::PathBuf;
-use std::process::Command;
 
 /// Four parts of a shipped family from twelve equal-area regions grouped by thickness and
 /// concavity, their boundaries snapped to creases (`--parts 4 --parts-from geometry`, default
@@ -19,36 +19,24 @@ fn parts_from_geometry(family: &str) -> (f64, f64) {
     if out.exists() {
         std::fs::remove_dir_all(&out).unwrap();
     }
-    let run = Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args([
-            "segment".as_ref(),
-            input.as_os_str(),
-            "-o".as_ref(),
-            out.as_os_str(),
-        ])
-        .args([
-            "-q",
-            "--no-pictures",
-            "--parts",
-            "4",
-            "--parts-from",
-            "geometry",
-        ])
-        .args([
-            "--features",
-            "spectral,extrinsic",
-            "--up",
-            "y",
-            "--normals",
-            "16",
-        ])
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let mut args = vec![
+        "segment",
+        arg(&input),
+        "-o",
+        arg(&out),
+        "-q",
+        "--no-pictures",
+    ];
+    args.extend(["--parts", "4", "--parts-from", "geometry"]);
+    args.extend([
+        "--features",
+        "spectral,extrinsic",
+        "--up",
+        "y",
+        "--normals",
+        "16",
+    ]);
+    coseg_ok(&args);
     let truth = GroundTruth::read(&input).unwrap();
     let shapes: Vec<ShapeParts> = truth
         .manifest

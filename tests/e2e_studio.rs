@@ -11,6 +11,7 @@
 
 mod common;
 
+use common::cli::{arg, coseg_ok};
 use common::generate::{collections_dir, read_labels};
 use common::studio::{PIPELINE, request, start, try_request};
 use serde_json::{Value, json};
@@ -415,24 +416,11 @@ fn mean_accuracy(dir: &Path, truth: &[Vec<u32>], sources: &[usize]) -> f64 {
 /// `coseg propagate` from the given label files, with the studio's pipeline and cache.
 fn cli_propagate(folder: &Path, cache: &Path, labels: &[PathBuf], out: &Path) {
     let list: Vec<String> = labels.iter().map(|p| p.display().to_string()).collect();
-    let run = Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .arg("propagate")
-        .arg(folder)
-        .arg("--labels")
-        .arg(list.join(","))
-        .arg("-o")
-        .arg(out)
-        .arg("--cache")
-        .arg(cache)
-        .arg("--no-pictures")
-        .args(PIPELINE)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "coseg propagate: {}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    let list = list.join(",");
+    let mut args = vec!["propagate", arg(folder), "--labels", &list, "-o", arg(out)];
+    args.extend(["--cache", arg(cache), "--no-pictures"]);
+    args.extend(PIPELINE);
+    coseg_ok(&args);
 }
 
 #[test]

@@ -20,6 +20,12 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// The per-shape flags of the binary's runs here: [`options`] as flags.
+#[rustfmt::skip]
+const PIPE: [&str; 10] = [
+    "--eigenpairs", "30", "--hks", "8", "--wks", "8", "--curvature", "8", "--bands", "6",
+];
+
 fn scratch(name: &str) -> PathBuf {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
         .join("faults")
@@ -285,17 +291,8 @@ fn a_full_disk_leaves_no_half_written_cache_entry_or_output() {
             .args([input.join("a.off"), input.join("b.off")])
             .arg("-o")
             .arg(out)
-            .args([
-                "--eigenpairs",
-                "30",
-                "--hks",
-                "8",
-                "--wks",
-                "8",
-                "--curvature",
-                "8",
-            ])
-            .args(["--bands", "6", "--map-size", "30"])
+            .args(PIPE)
+            .args(["--map-size", "30"])
             .output()
             .unwrap()
     };
@@ -339,17 +336,7 @@ fn two_processes_writing_one_cache_entry_leave_one_valid_entry() {
                 .arg(dir.join(format!("out{round}_{i}")))
                 .arg("--cache")
                 .arg(&cache)
-                .args([
-                    "--eigenpairs",
-                    "30",
-                    "--hks",
-                    "8",
-                    "--wks",
-                    "8",
-                    "--curvature",
-                    "8",
-                ])
-                .args(["--bands", "6"])
+                .args(PIPE)
                 .stdout(std::process::Stdio::null())
                 .stderr(std::process::Stdio::null())
                 .spawn()

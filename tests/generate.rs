@@ -2,8 +2,10 @@
 
 mod common;
 
+use common::cli::{arg, coseg, coseg_ok, text};
 use common::generate::{
-    assert_closed_oriented_single, collections_dir, read_collection_obj, read_labels, signed_volume,
+    assert_closed_oriented_single, collections_dir, consistently_oriented, read_collection_obj,
+    read_labels, signed_volume,
 };
 use coseg::generate::{
     Collection, Family, GenerateOptions, Manifest, ScalarGrid, generate_family,
@@ -181,15 +183,7 @@ fn marching_tetrahedra_random_fields_are_closed_consistently_oriented_manifolds(
             let mesh = TriMesh::new(p, f).unwrap();
             let (_, counts) = edges(&mesh);
             prop_assert!(counts.iter().all(|&c| c == 2));
-            let mut directed: Vec<(u32, u32)> = mesh
-                .faces()
-                .iter()
-                .flat_map(|f| [(f[0], f[1]), (f[1], f[2]), (f[2], f[0])])
-                .collect();
-            directed.sort_unstable();
-            let n = directed.len();
-            directed.dedup();
-            prop_assert_eq!(directed.len(), n);
+            prop_assert!(consistently_oriented(&mesh));
             prop_assert!(signed_volume(&mesh) > 0.0);
             // Every vertex is used by a face.
             let mut used = vec![false; mesh.vertex_count()];
@@ -500,16 +494,7 @@ fn listing(dir: &std::path::Path) -> Vec<String> {
 #[test]
 fn binary_regenerates_the_shipped_collections_byte_for_byte() {
     let tmp = tempfile::tempdir().unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args(["generate", "all", "-o"])
-        .arg(tmp.path())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    coseg_ok(&["generate", "all", "-o", arg(tmp.path())]);
     for family in Family::ALL {
         let shipped = collections_dir().join(family.name());
         let fresh = tmp.path().join(family.name());
@@ -585,26 +570,22 @@ fn write_collection_writes_manifest_that_round_trips() {
 #[test]
 fn binary_takes_seed_and_count_and_rejects_unknown_families() {
     let tmp = tempfile::tempdir().unwrap();
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args(["generate", "goblets", "--seed", "5", "--count", "2", "-o"])
-        .arg(tmp.path())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    coseg_ok(&[
+        "generate",
+        "goblets",
+        "--seed",
+        "5",
+        "--count",
+        "2",
+        "-o",
+        arg(tmp.path()),
+    ]);
     let m: Manifest =
         serde_json::from_str(&std::fs::read_to_string(tmp.path().join("manifest.json")).unwrap())
             .unwrap();
     assert_eq!((m.seed, m.shapes.len()), (5, 2));
     assert_eq!(listing(tmp.path()).len(), 5);
-    let bad = std::process::Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args(["generate", "dragons", "-o"])
-        .arg(tmp.path().join("x"))
-        .output()
-        .unwrap();
+    let bad = coseg(&["generate", "dragons", "-o", arg(&tmp.path().join("x"))]);
     assert!(!bad.status.success());
-    assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown family"));
+    assert!(text(&bad.stderr).contains("unknown family"));
 }

@@ -3,7 +3,7 @@
 mod common;
 
 use common::graph::{curve_table, permutation, permute_table, permute_values, random_weights};
-use common::stable::{noisy_copy, random_table, random_vec};
+use common::stable::{noisy_copy, random_table, random_vec, refinement, unsmoothed_rounds};
 use coseg::affinity::{BandAffinity, Direction, FeaturePairing};
 use coseg::bands::BandTable;
 use coseg::graph::{
@@ -296,31 +296,41 @@ fn cosegment_tuples_are_fixed_points_and_partition() {
     }
 }
 
-#[test]
-fn cosegment_of_permuted_copies_gives_the_same_regions() {
-    let d = 240;
-    let base = curve_table(d, 40, 8, 0.3, 21);
-    let perms: Vec<Vec<u32>> = (0..4)
+/// `copies` vertex-permuted copies of one random `d`-vertex shape (40 features, 8 bands; the
+/// first copy unpermuted), with permuted random areas: the permutations and the shape graph.
+/// `seeds`: of the table, of the permutations (the i-th copy's is `seeds[1] + i`), of the areas.
+fn permuted_copies(d: usize, copies: u64, seeds: [u64; 3]) -> (Vec<Vec<u32>>, ShapeGraph) {
+    let base = curve_table(d, 40, 8, 0.3, seeds[0]);
+    let perms: Vec<Vec<u32>> = (0..copies)
         .map(|i| {
             if i == 0 {
                 all(d)
             } else {
-                permutation(d, 50 + i)
+                permutation(d, seeds[1] + i)
             }
         })
         .collect();
-    let areas0: Vec<f64> = random_vec(d, 9).iter().map(|x| 0.5 + x).collect();
+    let areas0: Vec<f64> = random_vec(d, seeds[2]).iter().map(|x| 0.5 + x).collect();
     let tables: Vec<BandTable> = perms.iter().map(|p| permute_table(&base, p)).collect();
     let areas: Vec<Vec<f64>> = perms.iter().map(|p| permute_values(&areas0, p)).collect();
-    let mut g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
+    (perms, g)
+}
+
+/// `regions` regions from the given root shape (`None`: the library's choice).
+fn regions_from(regions: usize, root: Option<usize>) -> CosegmentOptions {
+    let mut opts = CosegmentOptions::default();
+    opts.regions = regions;
+    opts.root = root;
+    opts
+}
+
+#[test]
+fn cosegment_of_permuted_copies_gives_the_same_regions() {
+    let d = 240;
+    let (perms, mut g) = permuted_copies(d, 4, [21, 50, 9]);
     g.set_feature_weights(Some(random_weights(40, 8))).unwrap();
-    let c = cosegment(&g, &{
-        let mut opts = CosegmentOptions::default();
-        opts.regions = 4;
-        opts.root = Some(0);
-        opts
-    })
-    .unwrap();
+    let c = cosegment(&g, &regions_from(4, Some(0))).unwrap();
     let l0 = c.labels(0);
     for (i, p) in perms.iter().enumerate().skip(1) {
         let li = c.labels(i);
@@ -439,12 +449,7 @@ fn large_collections_get_a_connected_nearest_neighbour_graph() {
         assert!(g.neighbours(i).len() >= 2);
     }
     // And the co-segmentation runs on it.
-    let c = cosegment(&g, &{
-        let mut opts = CosegmentOptions::default();
-        opts.regions = 3;
-        opts
-    })
-    .unwrap();
+    let c = cosegment(&g, &regions_from(3, None)).unwrap();
     assert_eq!(c.order.len(), 16);
     // Deterministic construction.
     let g2 = ShapeGraph::build(nodes_from(&tables, &areas), &opts).unwrap();
@@ -499,23 +504,12 @@ fn graph_rejects_incompatible_shapes() {
 #[test]
 fn refine_cosegmentation_of_two_shapes_is_refine_partition() {
     use coseg::graph::refine_cosegmentation;
-    use coseg::stable::{RefineOptions, refine_partition};
+    use coseg::stable::refine_partition;
     for (regions, seed) in [(4, 5), (11, 6)] {
         let (tables, areas) = noisy_collection(2, 180, seed);
         let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
-        let c = cosegment(&g, &{
-            let mut opts = CosegmentOptions::default();
-            opts.regions = regions;
-            opts.root = Some(1);
-            opts
-        })
-        .unwrap();
-        let opts = {
-            let mut opts = RefineOptions::default();
-            opts.max_rounds = 20;
-            opts.smoothing_time = 0.0;
-            opts
-        };
+        let c = cosegment(&g, &regions_from(regions, Some(1))).unwrap();
+        let opts = unsmoothed_rounds(20);
         let refined = refine_cosegmentation(&g, &c, None, &opts).unwrap();
         let w = BandAffinity::new(&tables[0], &tables[1]).unwrap();
         let pair = refine_partition(&w, &c.labels(0), &c.labels(1), None, None, &opts).unwrap();
@@ -535,21 +529,10 @@ fn refine_cosegmentation_of_two_shapes_is_refine_partition() {
 #[test]
 fn refine_cosegmentation_reaches_a_fixed_point() {
     use coseg::graph::refine_cosegmentation;
-    use coseg::stable::RefineOptions;
     let (tables, areas) = noisy_collection(5, 200, 7);
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
-    let c = cosegment(&g, &{
-        let mut opts = CosegmentOptions::default();
-        opts.regions = 5;
-        opts
-    })
-    .unwrap();
-    let opts = {
-        let mut opts = RefineOptions::default();
-        opts.max_rounds = 50;
-        opts.smoothing_time = 0.0;
-        opts
-    };
+    let c = cosegment(&g, &regions_from(5, None)).unwrap();
+    let opts = unsmoothed_rounds(50);
     let r = refine_cosegmentation(&g, &c, None, &opts).unwrap();
     assert!(r.tuples[0].converged, "no fixed point in 50 sweeps");
     for i in 0..5 {
@@ -640,27 +623,8 @@ fn refine_cosegmentation_of_permuted_copies_agrees() {
     use coseg::graph::refine_cosegmentation;
     use coseg::stable::RefineOptions;
     let d = 240;
-    let base = curve_table(d, 40, 8, 0.3, 23);
-    let perms: Vec<Vec<u32>> = (0..3)
-        .map(|i| {
-            if i == 0 {
-                all(d)
-            } else {
-                permutation(d, 70 + i)
-            }
-        })
-        .collect();
-    let areas0: Vec<f64> = random_vec(d, 19).iter().map(|x| 0.5 + x).collect();
-    let tables: Vec<BandTable> = perms.iter().map(|p| permute_table(&base, p)).collect();
-    let areas: Vec<Vec<f64>> = perms.iter().map(|p| permute_values(&areas0, p)).collect();
-    let g = ShapeGraph::build(nodes_from(&tables, &areas), &GraphOptions::default()).unwrap();
-    let c = cosegment(&g, &{
-        let mut opts = CosegmentOptions::default();
-        opts.regions = 4;
-        opts.root = Some(0);
-        opts
-    })
-    .unwrap();
+    let (perms, g) = permuted_copies(d, 3, [23, 70, 19]);
+    let c = cosegment(&g, &regions_from(4, Some(0))).unwrap();
     let r = refine_cosegmentation(&g, &c, None, &RefineOptions::default()).unwrap();
     let l0 = r.labels(0);
     for (i, p) in perms.iter().enumerate().skip(1) {
@@ -673,36 +637,39 @@ fn refine_cosegmentation_of_permuted_copies_agrees() {
 
 // The one-call collection stage
 
+/// Four level-2 icospheres with noisy band tables of their vertex count (seeded `seed`), and
+/// four equal-area regions on the nodes' columns as they are (not the feature families chosen
+/// from the data).
+fn four_icospheres(
+    seed: u64,
+) -> (
+    Vec<coseg::mesh::TriMesh>,
+    Vec<BandTable>,
+    Vec<Vec<f64>>,
+    coseg::parts::SegmentCollectionOptions,
+) {
+    let mesh = common::shapes::icosphere(2, 1.0);
+    let (tables, areas) = noisy_collection(4, mesh.vertex_count(), seed);
+    let mut opts = coseg::parts::SegmentCollectionOptions::equal_areas(4);
+    opts.features = coseg::parts::FeatureSelection::Given;
+    (vec![mesh; 4], tables, areas, opts)
+}
+
 /// `segment_collection` is exactly graph → `cosegment` → smoothers → `refine_cosegmentation`
 /// (and just the first two without refinement); it rejects meshes that do not match.
 #[test]
 fn segment_collection_is_cosegment_then_refinement() {
     use coseg::graph::refine_cosegmentation;
-    use coseg::parts::{SegmentCollectionOptions, segment_collection};
+    use coseg::parts::segment_collection;
     use coseg::spectral::HeatSmoother;
-    use coseg::stable::RefineOptions;
-    let mesh = common::shapes::icosphere(2, 1.0);
-    let d = mesh.vertex_count();
-    let (tables, areas) = noisy_collection(4, d, 11);
-    let meshes = vec![mesh; 4];
-    let mut opts = {
-        let mut opts = SegmentCollectionOptions::equal_areas(4);
-        opts.refine = None;
-        // The nodes' columns as they are (not the feature families chosen from the data).
-        opts.features = coseg::parts::FeatureSelection::Given;
-        opts
-    };
+    let (meshes, tables, areas, mut opts) = four_icospheres(11);
+    opts.refine = None;
     let g = ShapeGraph::build(nodes_from(&tables, &areas), &opts.graph).unwrap();
     let raw = cosegment(&g, &opts.cosegment).unwrap();
     let out = segment_collection(nodes_from(&tables, &areas), &[], &opts).unwrap();
     assert_eq!(out.segmentation, raw);
 
-    let refine = {
-        let mut opts = RefineOptions::default();
-        opts.max_rounds = 7;
-        opts.smoothing_time = 0.01;
-        opts
-    };
+    let refine = refinement(7, 0.01);
     opts.refine = Some(refine.clone());
     let smoothers: Vec<HeatSmoother> = meshes
         .iter()
@@ -719,20 +686,9 @@ fn segment_collection_is_cosegment_then_refinement() {
 /// has the highest score (ties: the earliest), and one start is the plain run.
 #[test]
 fn segment_collection_keeps_the_start_of_highest_confidence() {
-    use coseg::parts::{SegmentCollectionOptions, segment_collection, start_score};
-    use coseg::stable::RefineOptions;
-    let mesh = common::shapes::icosphere(2, 1.0);
-    let d = mesh.vertex_count();
-    let (tables, areas) = noisy_collection(4, d, 5);
-    let meshes = vec![mesh; 4];
-    let mut opts = SegmentCollectionOptions::equal_areas(4);
-    opts.features = coseg::parts::FeatureSelection::Given;
-    opts.refine = Some({
-        let mut r = RefineOptions::default();
-        r.max_rounds = 3;
-        r.smoothing_time = 0.01;
-        r
-    });
+    use coseg::parts::{segment_collection, start_score};
+    let (meshes, tables, areas, mut opts) = four_icospheres(5);
+    opts.refine = Some(refinement(3, 0.01));
     let run = |starts: usize, seed: Option<u64>| {
         let mut o = opts.clone();
         o.starts = starts;

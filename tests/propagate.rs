@@ -3,6 +3,7 @@
 
 mod common;
 
+use common::cli::coseg;
 use common::generate::collections_dir;
 use coseg::bands::{BandTable, equal_count_bands};
 use coseg::evaluate::{read_labels, vertex_label_agreement};
@@ -10,7 +11,6 @@ use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
 use coseg::mesh::read_mesh;
 use coseg::propagate::{PropagateError, PropagateOptions, propagate_labels};
 use std::path::PathBuf;
-use std::process::Command;
 
 /// `count` shapes of `d` vertices whose features are those of one base shape, vertex order
 /// rotated by `i · shift` on shape `i` (vertex `v` of shape `i` is base vertex
@@ -251,13 +251,6 @@ fn coseg_propagate_on_the_shipped_chairs_with_the_extrinsic_family() {
     );
     assert!(mean >= CHAIR_FLOOR, "mean accuracy {mean}");
     let _ = std::fs::remove_dir_all(&out);
-}
-
-fn coseg(args: &[&std::ffi::OsStr]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_coseg"))
-        .args(args)
-        .output()
-        .expect("run coseg")
 }
 
 #[test]

@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::stable::{noisy_copy, random_table, random_vec};
+use common::stable::{noisy_copy, random_table, random_vec, unsmoothed_rounds};
 use coseg::affinity::{BandAffinity, Direction, dense_affinity};
 use coseg::stable::{
     Remaining, StablePairOptions, Threshold, ThresholdScratch, stable_pair, threshold,
@@ -45,116 +45,39 @@ fn area_threshold_stops_at_first_prefix_reaching_alpha() {
     let s = [4.0, 3.0, 3.0, 1.0];
     let areas = [1.0, 2.0, 0.5, 1.5];
     let (mut out, mut sc) = (Vec::new(), ThresholdScratch::default());
-    // Order: 0 (1.0), 1 (3.0), 2 (3.5), 3 (5.0). α·5 = 3 → {0, 1}.
-    threshold(
-        Threshold::AreaFraction(0.6),
-        &v,
-        &s,
-        &areas,
-        5.0,
-        &mut out,
-        &mut sc,
-    );
-    assert_eq!(out, vec![0, 1]);
-    threshold(
-        Threshold::AreaFraction(0.61),
-        &v,
-        &s,
-        &areas,
-        5.0,
-        &mut out,
-        &mut sc,
-    );
-    assert_eq!(out, vec![0, 1, 2]);
-    threshold(
-        Threshold::AreaFraction(0.0),
-        &v,
-        &s,
-        &areas,
-        5.0,
-        &mut out,
-        &mut sc,
-    );
-    assert!(out.is_empty());
-    threshold(
-        Threshold::AreaFraction(2.0),
-        &v,
-        &s,
-        &areas,
-        5.0,
-        &mut out,
-        &mut sc,
-    );
-    assert_eq!(out, vec![0, 1, 2, 3]);
+    // Order: 0 (1.0), 1 (3.0), 2 (3.5), 3 (5.0). α·5 = 3 → {0, 1}. One output and scratch
+    // across the cases: each call starts afresh.
+    for (alpha, want) in [
+        (0.6, vec![0, 1]),
+        (0.61, vec![0, 1, 2]),
+        (0.0, vec![]),
+        (2.0, vec![0, 1, 2, 3]),
+    ] {
+        let rule = Threshold::AreaFraction(alpha);
+        threshold(rule, &v, &s, &areas, 5.0, &mut out, &mut sc);
+        assert_eq!(out, want, "{rule:?}");
+    }
 }
 
 #[test]
 fn mean_std_threshold() {
     let v = [0, 1, 2, 3];
     let s = [1.0, 2.0, 3.0, 4.0]; // μ = 2.5, σ = √1.25
+    let flat = [2.0; 4];
     let (mut out, mut sc) = (Vec::new(), ThresholdScratch::default());
     let areas = [1.0; 4];
-    threshold(
-        Threshold::MeanStd(0.0),
-        &v,
-        &s,
-        &areas,
-        4.0,
-        &mut out,
-        &mut sc,
-    );
-    assert_eq!(out, vec![2, 3]);
-    threshold(
-        Threshold::MeanStd(1.0),
-        &v,
-        &s,
-        &areas,
-        4.0,
-        &mut out,
-        &mut sc,
-    );
-    assert_eq!(out, vec![3]); // 2.5 + 1.118 = 3.618
-    threshold(
-        Threshold::MeanStd(1.5),
-        &v,
-        &s,
-        &areas,
-        4.0,
-        &mut out,
-        &mut sc,
-    );
-    assert!(out.is_empty()); // 2.5 + 1.677 > 4
-    threshold(
-        Threshold::MeanStd(-1.0),
-        &v,
-        &s,
-        &areas,
-        4.0,
-        &mut out,
-        &mut sc,
-    );
-    assert_eq!(out, vec![1, 2, 3]);
-    let flat = [2.0; 4];
-    threshold(
-        Threshold::MeanStd(0.0),
-        &v,
-        &flat,
-        &areas,
-        4.0,
-        &mut out,
-        &mut sc,
-    );
-    assert_eq!(out, vec![0, 1, 2, 3]);
-    threshold(
-        Threshold::MeanStd(0.1),
-        &v,
-        &flat,
-        &areas,
-        4.0,
-        &mut out,
-        &mut sc,
-    );
-    assert!(out.is_empty());
+    for (k, scores, want) in [
+        (0.0, &s, vec![2, 3]),
+        (1.0, &s, vec![3]), // 2.5 + 1.118 = 3.618
+        (1.5, &s, vec![]),  // 2.5 + 1.677 > 4
+        (-1.0, &s, vec![1, 2, 3]),
+        (0.0, &flat, vec![0, 1, 2, 3]),
+        (0.1, &flat, vec![]),
+    ] {
+        let rule = Threshold::MeanStd(k);
+        threshold(rule, &v, scores, &areas, 4.0, &mut out, &mut sc);
+        assert_eq!(out, want, "{rule:?} on {scores:?}");
+    }
 }
 
 /// Checks W-stability of (f, g) on the remaining sets with the dense W: no single exchange of
@@ -170,38 +93,30 @@ fn assert_w_stable(d: &[f64], cols: usize, ra: &[u32], rb: &[u32], f: &[u32], g:
         .map(|&p| g.iter().map(|&q| d[q as usize * cols + p as usize]).sum())
         .collect();
     let tol = 1e-15;
-    let min_in_b = rb
-        .iter()
-        .zip(&sb)
-        .filter(|(q, _)| g.contains(q))
-        .map(|(_, s)| *s)
-        .fold(f64::INFINITY, f64::min);
-    let max_out_b = rb
-        .iter()
-        .zip(&sb)
-        .filter(|(q, _)| !g.contains(q))
-        .map(|(_, s)| *s)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (min_in_b, max_out_b) = in_and_out(rb, &sb, g);
     assert!(
         max_out_b <= min_in_b + tol,
         "B swap improves: {max_out_b} > {min_in_b}"
     );
-    let min_in_a = ra
-        .iter()
-        .zip(&sa)
-        .filter(|(p, _)| f.contains(p))
-        .map(|(_, s)| *s)
-        .fold(f64::INFINITY, f64::min);
-    let max_out_a = ra
-        .iter()
-        .zip(&sa)
-        .filter(|(p, _)| !f.contains(p))
-        .map(|(_, s)| *s)
-        .fold(f64::NEG_INFINITY, f64::max);
+    let (min_in_a, max_out_a) = in_and_out(ra, &sa, f);
     assert!(
         max_out_a <= min_in_a + tol,
         "A swap improves: {max_out_a} > {min_in_a}"
     );
+}
+
+/// The lowest score among the `selected` vertices of `remaining` and the highest among the
+/// others (`scores[i]` of `remaining[i]`).
+fn in_and_out(remaining: &[u32], scores: &[f64], selected: &[u32]) -> (f64, f64) {
+    let (mut min_in, mut max_out) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (v, &s) in remaining.iter().zip(scores) {
+        if selected.contains(v) {
+            min_in = min_in.min(s);
+        } else {
+            max_out = max_out.max(s);
+        }
+    }
+    (min_in, max_out)
 }
 
 #[test]
@@ -628,7 +543,7 @@ fn correspondence_stats_separate_the_leftover_pair() {
 /// dense affinity: B from A's partition, then A from B's new partition.
 #[test]
 fn refine_partition_one_round_matches_dense_best_response() {
-    use coseg::stable::{RefineOptions, refine_partition};
+    use coseg::stable::refine_partition;
     let (da, db, n, k, regions) = (70, 55, 12, 5, 4usize);
     let a = random_table(da, n, k, 41);
     let b = noisy_copy(&random_table(db, n, k, 42), 0.9, 43);
@@ -659,12 +574,7 @@ fn refine_partition_one_round_matches_dense_best_response() {
     let count = |q: usize, p: usize| (dense[q * da + p] / w.unit()).round();
     let new_b = best(&|q, r| mean_to(&la, r, &|p| count(q, p)), db);
     let new_a = best(&|p, r| mean_to(&new_b, r, &|q| count(q, p)), da);
-    let opts = {
-        let mut opts = RefineOptions::default();
-        opts.max_rounds = 1;
-        opts.smoothing_time = 0.0;
-        opts
-    };
+    let opts = unsmoothed_rounds(1);
     let r = refine_partition(&w, &la, &lb, None, None, &opts).unwrap();
     assert_eq!(r.labels_b, new_b);
     assert_eq!(r.labels_a, new_a);
@@ -675,18 +585,13 @@ fn refine_partition_one_round_matches_dense_best_response() {
 /// output is deterministic and every vertex gets a region in range.
 #[test]
 fn refine_partition_converged_output_is_a_fixed_point() {
-    use coseg::stable::{RefineOptions, refine_partition};
+    use coseg::stable::refine_partition;
     let a = random_table(300, 24, 8, 51);
     let b = noisy_copy(&a, 0.8, 52);
     let w = BandAffinity::new(&a, &b).unwrap();
     let la: Vec<i32> = (0..300).map(|p| p % 5).collect();
     let lb: Vec<i32> = (0..300).map(|q| (q / 60) % 5).collect();
-    let opts = {
-        let mut opts = RefineOptions::default();
-        opts.max_rounds = 50;
-        opts.smoothing_time = 0.0;
-        opts
-    };
+    let opts = unsmoothed_rounds(50);
     let r = refine_partition(&w, &la, &lb, None, None, &opts).unwrap();
     assert!(r.converged, "no fixed point within 50 rounds");
     assert!(
@@ -775,18 +680,13 @@ fn refine_regions_rebuilds_pairs_with_dense_objectives() {
             "{} vs {obj}",
             new.objective
         );
-        let fa: f64 = new
-            .region_a
-            .iter()
-            .map(|&v| areas_a[v as usize])
-            .sum::<f64>()
-            / ta;
-        let fb: f64 = new
-            .region_b
-            .iter()
-            .map(|&v| areas_b[v as usize])
-            .sum::<f64>()
-            / tb;
+        let share = |region: &[u32], areas: &[f64], total: f64| {
+            region.iter().map(|&v| areas[v as usize]).sum::<f64>() / total
+        };
+        let (fa, fb) = (
+            share(&new.region_a, &areas_a, ta),
+            share(&new.region_b, &areas_b, tb),
+        );
         assert!(
             (new.area_fraction_a - fa).abs() < 1e-12 && (new.area_fraction_b - fb).abs() < 1e-12
         );
@@ -1085,20 +985,7 @@ mod map_guided {
     fn segment_pair_equals_its_stages_run_by_hand() {
         let (a, b, _, da, db) = permuted_pair();
         let options = {
-            let mut o2 = SegmentPairOptions::default();
-            o2.regions = {
-                let mut opts = StableRegionsOptions::default();
-                opts.pairs = 6;
-                opts.p = Threshold::AreaFraction(1.0 / 6.0);
-                opts.q = Threshold::AreaFraction(1.0 / 6.0);
-                opts
-            };
-            o2.refine = Some(RefineOptions::default());
-            o2.map_step = MapStep::Options({
-                let mut opts = MapGuidedOptions::default();
-                opts.point_map = options();
-                opts
-            });
+            let mut o2 = six_pairs();
             o2.map_after_refine = true;
             o2
         };

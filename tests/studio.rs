@@ -6,25 +6,10 @@
 mod common;
 
 use common::features::small_pipeline;
-use common::generate::collections_dir;
+use common::generate::{collections_dir, goblets};
 use coseg::mesh::{TriMesh, read_mesh};
 use coseg::studio::{Palette, PatchOptions, Studio, StudioError, StudioOptions, crease_patches};
-use std::path::{Path, PathBuf};
-
-/// The first `count` shipped goblets (meshes only) copied into `dir/shapes`.
-fn goblets(dir: &Path, count: usize) -> PathBuf {
-    let folder = dir.join("shapes");
-    std::fs::create_dir_all(&folder).unwrap();
-    for i in 0..count {
-        let name = format!("goblets_{i:02}.obj");
-        std::fs::copy(
-            collections_dir().join("goblets").join(&name),
-            folder.join(&name),
-        )
-        .unwrap();
-    }
-    folder
-}
+use std::path::Path;
 
 fn options(dir: &Path) -> StudioOptions {
     let mut o = StudioOptions::default();

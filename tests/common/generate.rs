@@ -34,14 +34,9 @@ pub fn signed_volume(mesh: &coseg::mesh::TriMesh) -> f64 {
         .sum()
 }
 
-/// Panics unless `mesh` is a closed, consistently oriented 2-manifold with one component:
-/// every undirected edge in exactly two faces, every directed edge in exactly one.
-pub fn assert_closed_oriented_single(mesh: &coseg::mesh::TriMesh, what: &str) {
-    let (_, counts) = coseg::mesh::edges(mesh);
-    assert!(
-        counts.iter().all(|&c| c == 2),
-        "{what}: an edge is not shared by exactly 2 faces"
-    );
+/// Whether every directed edge of `mesh` is in one face at most (neighbouring faces list their
+/// shared edge in opposite directions).
+pub fn consistently_oriented(mesh: &coseg::mesh::TriMesh) -> bool {
     let mut directed: Vec<(u32, u32)> = mesh
         .faces()
         .iter()
@@ -50,7 +45,21 @@ pub fn assert_closed_oriented_single(mesh: &coseg::mesh::TriMesh, what: &str) {
     directed.sort_unstable();
     let n = directed.len();
     directed.dedup();
-    assert_eq!(directed.len(), n, "{what}: inconsistent orientation");
+    directed.len() == n
+}
+
+/// Panics unless `mesh` is a closed, consistently oriented 2-manifold with one component:
+/// every undirected edge in exactly two faces, every directed edge in exactly one.
+pub fn assert_closed_oriented_single(mesh: &coseg::mesh::TriMesh, what: &str) {
+    let (_, counts) = coseg::mesh::edges(mesh);
+    assert!(
+        counts.iter().all(|&c| c == 2),
+        "{what}: an edge is not shared by exactly 2 faces"
+    );
+    assert!(
+        consistently_oriented(mesh),
+        "{what}: inconsistent orientation"
+    );
     assert_eq!(
         coseg::mesh::connected_components(mesh).count,
         1,
@@ -80,4 +89,20 @@ pub fn read_collection_obj(path: &std::path::Path) -> coseg::mesh::TriMesh {
         }
     }
     coseg::mesh::TriMesh::new(positions, faces).unwrap()
+}
+
+/// The first `count` shipped goblets copied into `dir/shapes` (a collection a test may write
+/// beside); the folder.
+pub fn goblets(dir: &std::path::Path, count: usize) -> PathBuf {
+    let folder = dir.join("shapes");
+    std::fs::create_dir_all(&folder).unwrap();
+    for i in 0..count {
+        let name = format!("goblets_{i:02}.obj");
+        std::fs::copy(
+            collections_dir().join("goblets").join(&name),
+            folder.join(&name),
+        )
+        .unwrap();
+    }
+    folder
 }

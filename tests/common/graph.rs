@@ -80,17 +80,7 @@ pub fn random_weights(n: usize, seed: u64) -> Vec<f64> {
 pub fn coseg_of(meshes: &[TriMesh], parts: &[Vec<Vec<u32>>]) -> Cosegmentation {
     let n = meshes.len();
     let tuples = (0..parts[0].len())
-        .map(|t| RegionTuple {
-            area_fractions: vec![0.0; n],
-            regions: parts.iter().map(|p| p[t].clone()).collect(),
-            sweeps: 0,
-            converged: true,
-            cycled: false,
-            objective: 0.0,
-            confidence: 1.0,
-            cycle_consistency: None,
-            leftover: false,
-        })
+        .map(|t| RegionTuple::given(parts.iter().map(|p| p[t].clone()).collect(), vec![0.0; n]))
         .collect();
     Cosegmentation {
         names: (0..n).map(|i| format!("s{i}")).collect(),

@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod adversarial;
+pub mod cli;
 pub mod features;
 pub mod generate;
 pub mod graph;

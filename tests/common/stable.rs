@@ -70,3 +70,16 @@ pub fn random_vec(n: usize, seed: u64) -> Vec<f64> {
         .map(|_| (rng.next_u64() >> 11) as f64 / (1u64 << 53) as f64)
         .collect()
 }
+
+/// Refinement of at most `rounds` sweeps with heat smoothing over `smoothing_time`.
+pub fn refinement(rounds: usize, smoothing_time: f64) -> coseg::stable::RefineOptions {
+    let mut opts = coseg::stable::RefineOptions::default();
+    opts.max_rounds = rounds;
+    opts.smoothing_time = smoothing_time;
+    opts
+}
+
+/// Refinement of at most `rounds` sweeps without heat smoothing (the bare affinity votes).
+pub fn unsmoothed_rounds(rounds: usize) -> coseg::stable::RefineOptions {
+    refinement(rounds, 0.0)
+}

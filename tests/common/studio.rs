@@ -9,17 +9,9 @@ use std::time::Duration;
 
 /// The small per-shape pipeline the studio tests run with (`coseg studio` and `coseg
 /// propagate` take the same flags), so that a debug build opens a family in seconds.
+#[rustfmt::skip]
 pub const PIPELINE: [&str; 10] = [
-    "--eigenpairs",
-    "30",
-    "--hks",
-    "8",
-    "--wks",
-    "8",
-    "--curvature",
-    "8",
-    "--bands",
-    "8",
+    "--eigenpairs", "30", "--hks", "8", "--wks", "8", "--curvature", "8", "--bands", "8",
 ];
 
 /// A running `coseg studio`; killed on drop.
