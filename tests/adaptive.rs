@@ -1,5 +1,7 @@
 //! Tests of the adaptive co-segmentation (parts of their own size, `coseg::parts::adaptive_cosegment`).
 
+mod common;
+
 use coseg::bands::{BandTable, equal_count_bands};
 use coseg::graph::{
     CosegmentOptions, Cosegmentation, GraphOptions, RefineSizes, ShapeGraph, ShapeNode, cosegment,
@@ -137,11 +139,9 @@ fn sizes_follow_the_data_on_unequal_parts() {
 fn deterministic_across_thread_counts() {
     let (g, _, _) = collection();
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| adaptive_cosegment(&g, &AdaptiveOptions::default()).unwrap())
+        crate::common::on_threads(threads, || {
+            adaptive_cosegment(&g, &AdaptiveOptions::default()).unwrap()
+        })
     };
     let (one, two) = (run(1), run(2));
     assert_eq!(one, two);

@@ -18,16 +18,9 @@ use coseg::mesh::{TriMesh, read_mesh, write_mesh};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
-/// A fresh, empty scratch folder `name` under Cargo's per-target temporary directory.
+/// [`common::scratch`] in `adversarial/`.
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("adversarial")
-        .join(name);
-    if dir.exists() {
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch("adversarial", name)
 }
 
 fn text(o: &Output) -> (String, String) {
@@ -616,13 +609,9 @@ fn a_missing_file_is_reported_once() {
 /// them), and the result is exactly the run without the map step.
 #[test]
 fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run() {
-    use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
+    use coseg::pipeline::compute_shape_data;
     use coseg::stable::{PairShape, PairStage, SegmentPairOptions, segment_pair};
-    let mut pipe = ShapePipelineOptions::default();
-    pipe.spectrum.eigenpairs = 40;
-    pipe.descriptors.hks_count = 8;
-    pipe.descriptors.wks_count = 8;
-    pipe.descriptors.curvature_count = 8;
+    let mut pipe = common::features::small_pipeline(40, 8);
     pipe.bands.bands = 6;
     let meshes: Vec<TriMesh> = [1, 2]
         .iter()

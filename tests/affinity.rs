@@ -201,16 +201,8 @@ fn parallel_equals_serial_bitwise() {
         w.apply(&x, &mut out, &mut ws).unwrap();
         out
     };
-    let serial = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap()
-        .install(run);
-    let parallel = rayon::ThreadPoolBuilder::new()
-        .num_threads(3)
-        .build()
-        .unwrap()
-        .install(run);
+    let serial = crate::common::on_threads(1, run);
+    let parallel = crate::common::on_threads(3, run);
     assert!(
         serial
             .iter()

@@ -42,17 +42,9 @@ fn ground_truth() -> &'static GroundTruth {
     TRUTH.get_or_init(|| GroundTruth::read(quadrupeds()).unwrap())
 }
 
-/// A fresh, empty scratch folder `name` under Cargo's per-target temporary directory (kept
-/// after the run for inspection, emptied at the next).
+/// [`common::scratch`] in `e2e/`.
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("e2e")
-        .join(name);
-    if dir.exists() {
-        std::fs::remove_dir_all(&dir).unwrap();
-    }
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::scratch("e2e", name)
 }
 
 fn coseg(args: &[&Path]) -> Output {

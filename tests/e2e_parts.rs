@@ -59,6 +59,15 @@ fn parts_from_geometry(family: &str) -> (f64, f64) {
     scores
 }
 
+/// [`parts_from_geometry`] on `family` reaches at least `purity` and `coverage`.
+fn meets_the_bar(family: &str, purity: f64, coverage: f64) {
+    let (p, c) = parts_from_geometry(family);
+    assert!(
+        p >= purity && c >= coverage,
+        "{family}: {p:.3} / {c:.3}, floors {purity} / {coverage}"
+    );
+}
+
 /// The bar of the parts issue is coverage ≥ 75 % at purity ≥ 85 %; the floors keep a margin
 /// below what was measured (docs/PARTS.md, "Boundaries snapped to creases" and "Regions split
 /// into their pieces").
@@ -66,22 +75,14 @@ fn parts_from_geometry(family: &str) -> (f64, f64) {
 fn quadrupeds_parts_from_geometry_meet_the_bar() {
     // Measured 0.851 / 0.912 (before the regions were split into their pieces 0.784 / 0.818:
     // one region held a back leg's tip and the tail's).
-    let (purity, coverage) = parts_from_geometry("quadrupeds");
-    assert!(
-        purity >= 0.84 && coverage >= 0.88,
-        "{purity:.3} / {coverage:.3}"
-    );
+    meets_the_bar("quadrupeds", 0.84, 0.88);
 }
 
 #[test]
 fn humanoids_parts_from_geometry_meet_the_bar() {
     // Measured 0.952 / 0.946 (without snapping 0.914 / 0.909; adaptive `--parts 4`: 0.668 /
     // 0.739).
-    let (purity, coverage) = parts_from_geometry("humanoids");
-    assert!(
-        purity >= 0.92 && coverage >= 0.92,
-        "{purity:.3} / {coverage:.3}"
-    );
+    meets_the_bar("humanoids", 0.92, 0.92);
 }
 
 #[test]
@@ -90,11 +91,7 @@ fn chairs_parts_from_geometry_meet_the_bar() {
     // at an extra cost): 0.907 / 0.731, the front and back legs two parts; now their feet,
     // facing the same way, are copies linked like mirror pairs (docs/PARTS.md, "Copies and
     // look-alikes").
-    let (purity, coverage) = parts_from_geometry("chairs");
-    assert!(
-        purity >= 0.88 && coverage >= 0.76,
-        "{purity:.3} / {coverage:.3}"
-    );
+    meets_the_bar("chairs", 0.88, 0.76);
     // The summary names the copies: pairs of leaves split from one region (the feet).
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("e2e_parts_chairs");
     let summary: serde_json::Value =
@@ -111,9 +108,5 @@ fn chairs_parts_from_geometry_meet_the_bar() {
 #[test]
 fn goblets_parts_from_geometry_meet_the_bar() {
     // Measured 0.921 / 0.826 (without snapping 0.916 / 0.821).
-    let (purity, coverage) = parts_from_geometry("goblets");
-    assert!(
-        purity >= 0.90 && coverage >= 0.80,
-        "{purity:.3} / {coverage:.3}"
-    );
+    meets_the_bar("goblets", 0.90, 0.80);
 }

@@ -10,6 +10,7 @@
 mod common;
 
 use common::adversarial::base_sphere;
+use common::features::small_pipeline;
 use coseg::cache::{CacheOutcome, cache_path};
 use coseg::mesh::{TriMesh, write_atomic, write_mesh};
 use coseg::pipeline::{
@@ -43,11 +44,7 @@ fn sphere(seed: u64) -> TriMesh {
 }
 
 fn options() -> ShapePipelineOptions {
-    let mut o = ShapePipelineOptions::default();
-    o.spectrum.eigenpairs = 30;
-    o.descriptors.hks_count = 8;
-    o.descriptors.wks_count = 8;
-    o.descriptors.curvature_count = 8;
+    let mut o = small_pipeline(30, 8);
     o.bands.bands = 6;
     o
 }

@@ -232,13 +232,7 @@ fn sdf_ranks_survive_rigid_motion_scaling_and_permutation_on_a_shipped_shape() {
 fn sdf_is_bit_identical_across_runs_and_thread_counts() {
     let m = shipped_chair();
     let o = SdfOptions::default();
-    let run = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| shape_diameter(&m, &o).unwrap())
-    };
+    let run = |threads| crate::common::on_threads(threads, || shape_diameter(&m, &o).unwrap());
     let a = run(1);
     let b = run(2);
     let c = run(2);

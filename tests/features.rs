@@ -321,11 +321,7 @@ fn output_is_bitwise_identical_across_runs_and_thread_counts() {
     let mesh = blob(3);
     let s = dense_spectrum(&mesh, 40).unwrap();
     let run = |threads: usize| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| descriptors(&mesh, &s, &small_opts()).unwrap())
+        crate::common::on_threads(threads, || descriptors(&mesh, &s, &small_opts()).unwrap())
     };
     let (a, b, c) = (run(1), run(2), run(3));
     let bits =

@@ -8,7 +8,7 @@ use coseg::mesh::{
     read_mesh_from_bytes, read_mesh_with_report, write_atomic, write_mesh,
 };
 use proptest::prelude::*;
-use proptest::test_runner::{Config, RngSeed};
+use proptest::test_runner::Config;
 use std::path::{Path, PathBuf};
 
 fn tmp() -> tempfile::TempDir {
@@ -331,12 +331,7 @@ fn finite_f64() -> impl Strategy<Value = f64> {
 }
 
 fn fixed(cases: u32) -> Config {
-    Config {
-        cases,
-        rng_seed: RngSeed::Fixed(0xC05E6),
-        failure_persistence: None,
-        ..Config::default()
-    }
+    common::fixed_cases(cases, 0xC05E6)
 }
 
 proptest! {

@@ -3,14 +3,14 @@
 
 mod common;
 
-use common::cli::coseg;
+use common::cli::{arg, coseg};
 use common::generate::collections_dir;
 use coseg::bands::{BandTable, equal_count_bands};
 use coseg::evaluate::{read_labels, vertex_label_agreement};
 use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
 use coseg::mesh::read_mesh;
 use coseg::propagate::{PropagateError, PropagateOptions, propagate_labels};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// `count` shapes of `d` vertices whose features are those of one base shape, vertex order
 /// rotated by `i · shift` on shape `i` (vertex `v` of shape `i` is base vertex
@@ -211,27 +211,34 @@ const GOBLET_FLOOR: f64 = 0.72;
 /// mirror-image legs apart); the floor sits a little below.
 const CHAIR_FLOOR: f64 = 0.66;
 
+/// `coseg propagate FOLDER --labels LABELS -o OUT --cache CACHE EXTRA`.
+fn propagate_cli(
+    folder: &Path,
+    labels: &Path,
+    out: &Path,
+    cache: &Path,
+    extra: &[&str],
+) -> std::process::Output {
+    let mut args = vec!["propagate", arg(folder), "--labels", arg(labels)];
+    args.extend(["-o", arg(out), "--cache", arg(cache)]);
+    args.extend(extra);
+    coseg(&args)
+}
+
 #[test]
 fn coseg_propagate_on_the_shipped_chairs_with_the_extrinsic_family() {
     let dir = collections_dir().join("chairs");
     let out = std::env::temp_dir().join(format!("coseg-propagate-chairs-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let src = dir.join("chairs_00.labels.txt");
-    let r = coseg(&[
-        "propagate".as_ref(),
-        dir.as_os_str(),
-        "--labels".as_ref(),
-        src.as_os_str(),
-        "-o".as_ref(),
-        out.join("a").as_os_str(),
-        "--cache".as_ref(),
-        out.join("cache").as_os_str(),
-        "--features".as_ref(),
-        "spectral,extrinsic".as_ref(),
-        "--up".as_ref(),
-        "y".as_ref(),
-        "--no-pictures".as_ref(),
-    ]);
+    let extra = [
+        "--features",
+        "spectral,extrinsic",
+        "--up",
+        "y",
+        "--no-pictures",
+    ];
+    let r = propagate_cli(&dir, &src, &out.join("a"), &out.join("cache"), &extra);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
     let mut accs = Vec::new();
     for i in 1..6 {
@@ -259,18 +266,7 @@ fn coseg_propagate_on_the_shipped_goblets() {
     let out = std::env::temp_dir().join(format!("coseg-propagate-e2e-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&out);
     let src = dir.join("goblets_00.labels.txt");
-    let run = |o: &PathBuf| {
-        coseg(&[
-            "propagate".as_ref(),
-            dir.as_os_str(),
-            "--labels".as_ref(),
-            src.as_os_str(),
-            "-o".as_ref(),
-            o.as_os_str(),
-            "--cache".as_ref(),
-            out.join("cache").as_os_str(),
-        ])
-    };
+    let run = |o: &PathBuf| propagate_cli(&dir, &src, o, &out.join("cache"), &[]);
     let o1 = out.join("a");
     let r = run(&o1);
     assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
@@ -315,16 +311,7 @@ fn coseg_propagate_on_the_shipped_goblets() {
     // A label file for no mesh is an error naming it.
     let bad = out.join("nomesh.labels.txt");
     std::fs::write(&bad, "0\n").unwrap();
-    let r = coseg(&[
-        "propagate".as_ref(),
-        dir.as_os_str(),
-        "--labels".as_ref(),
-        bad.as_os_str(),
-        "-o".as_ref(),
-        out.join("c").as_os_str(),
-        "--cache".as_ref(),
-        out.join("cache").as_os_str(),
-    ]);
+    let r = propagate_cli(&dir, &bad, &out.join("c"), &out.join("cache"), &[]);
     assert!(!r.status.success());
     assert!(String::from_utf8_lossy(&r.stderr).contains("nomesh.labels.txt"));
     std::fs::remove_dir_all(&out).unwrap();
@@ -549,24 +536,12 @@ fn coseg_propagate_map_step_on_isometric_copies() {
         copies.push((format!("c{k}"), copy, truth_copy));
     }
     let run = |out: &std::path::Path, map: bool| {
-        let mut args: Vec<std::ffi::OsString> = vec![
-            "propagate".into(),
-            shapes.clone().into(),
-            "--labels".into(),
-            dir.path().join("a.labels.txt").into(),
-            "-o".into(),
-            out.into(),
-            "--cache".into(),
-            dir.path().join("cache").into(),
-            "--eigenpairs".into(),
-            "40".into(),
-            "--no-pictures".into(),
-        ];
+        let mut extra = vec!["--eigenpairs", "40", "--no-pictures"];
         if map {
-            args.push("--map-step".into());
+            extra.push("--map-step");
         }
-        let refs: Vec<&std::ffi::OsStr> = args.iter().map(|a| a.as_os_str()).collect();
-        let r = coseg(&refs);
+        let (labels, cache) = (dir.path().join("a.labels.txt"), dir.path().join("cache"));
+        let r = propagate_cli(&shapes, &labels, out, &cache, &extra);
         assert!(r.status.success(), "{}", String::from_utf8_lossy(&r.stderr));
         serde_json::from_str::<serde_json::Value>(
             &std::fs::read_to_string(out.join("summary.json")).unwrap(),

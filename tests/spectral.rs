@@ -714,7 +714,7 @@ mod zoomout_descriptors {
 mod auction {
     use coseg::maps::{AuctionOptions, CandidateLists, auction_assignment};
     use proptest::prelude::*;
-    use proptest::test_runner::{Config, RngSeed};
+    use proptest::test_runner::Config;
 
     /// Dense candidate lists from a `queries × targets` cost matrix (row-major), each row
     /// sorted ascending as the function requires.
@@ -765,12 +765,7 @@ mod auction {
     }
 
     fn fixed(cases: u32) -> Config {
-        Config {
-            cases,
-            rng_seed: RngSeed::Fixed(0xA0C7),
-            failure_persistence: None,
-            ..Config::default()
-        }
+        crate::common::fixed_cases(cases, 0xA0C7)
     }
 
     proptest! {
@@ -955,15 +950,13 @@ mod auction {
 }
 
 mod discrepancy {
-    use super::common::features::{blob, permutation, permute_mesh};
+    use super::common::features::{blob, permutation, permute_mesh, spectrum_of};
     use coseg::maps::eigenvalue_discrepancy;
-    use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 
     #[test]
     fn eigenvalue_discrepancy_is_zero_for_isometric_copies_and_grows_with_stretch() {
         let a = blob(2);
-        let opts = SpectrumOptions::with_eigenpairs(20);
-        let spectrum = |m| laplace_beltrami_spectrum(m, &opts).unwrap();
+        let spectrum = |m| spectrum_of(m, 20);
         let sa = spectrum(&a);
         // Permuted, scaled and rotated copies have the same unit-area spectrum.
         let perm = permutation(a.vertex_count(), 3);
@@ -1226,11 +1219,9 @@ fn spectrum_is_bit_identical_across_thread_counts() {
     let solve = |pool_threads: usize, solver_threads: usize| {
         let mut opts = sparse_opts(60);
         opts.threads = solver_threads;
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(pool_threads)
-            .build()
-            .unwrap()
-            .install(|| laplace_beltrami_spectrum(&mesh, &opts).unwrap())
+        crate::common::on_threads(pool_threads, || {
+            laplace_beltrami_spectrum(&mesh, &opts).unwrap()
+        })
     };
     let sequential = solve(1, 1);
     for (pool, solver) in [(2, 0), (3, 0), (2, 2), (4, 1)] {

@@ -207,16 +207,8 @@ fn algorithm1_is_deterministic_and_thread_independent() {
     };
     let opts = StablePairOptions::default();
     let run = || stable_pair(&w, &rem, &[5, 17, 2000], &opts).unwrap();
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .unwrap()
-        .install(run);
-    let two = rayon::ThreadPoolBuilder::new()
-        .num_threads(2)
-        .build()
-        .unwrap()
-        .install(run);
+    let one = crate::common::on_threads(1, run);
+    let two = crate::common::on_threads(2, run);
     assert_eq!(one, two);
     assert!(one.converged);
     // Area rule: the region's area is the first prefix to reach 10 %.
@@ -1196,16 +1188,14 @@ mod map_guided {
 }
 
 mod preset {
-    use super::common::features::{blob, permutation, permute_mesh};
+    use super::common::features::{blob, permutation, permute_mesh, spectrum_of};
     use coseg::maps::MapGuidedOptions;
     use coseg::maps::{MapPreset, map_preset};
-    use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 
     #[test]
     fn map_preset_tells_a_repose_from_a_different_body() {
         let a = blob(2);
-        let opts = SpectrumOptions::with_eigenpairs(24);
-        let spectrum = |m| laplace_beltrami_spectrum(m, &opts).unwrap();
+        let spectrum = |m| spectrum_of(m, 24);
         let sa = spectrum(&a);
         let copy = permute_mesh(&a, &permutation(a.vertex_count(), 9));
         let same = map_preset(&sa, &spectrum(&copy)).unwrap();
@@ -1221,7 +1211,7 @@ mod preset {
             MapGuidedOptions::near_isometric()
         );
         // Spectra shorter than the 20 eigenvalues compared: the common length is used.
-        let short = laplace_beltrami_spectrum(&a, &SpectrumOptions::with_eigenpairs(5)).unwrap();
+        let short = spectrum_of(&a, 5);
         assert_eq!(
             map_preset(&sa, &short).unwrap().preset,
             MapPreset::NearIsometric

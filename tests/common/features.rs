@@ -102,3 +102,12 @@ pub fn small_pipeline(eigenpairs: usize, per_kind: usize) -> coseg::pipeline::Sh
     o.bands.bands = 8;
     o
 }
+
+/// The `k` smallest Laplace–Beltrami eigenpairs of `mesh` (the library's other defaults).
+pub fn spectrum_of(mesh: &coseg::mesh::TriMesh, k: usize) -> coseg::spectral::Spectrum {
+    coseg::spectral::laplace_beltrami_spectrum(
+        mesh,
+        &coseg::spectral::SpectrumOptions::with_eigenpairs(k),
+    )
+    .unwrap()
+}

@@ -24,3 +24,36 @@ pub fn shared_data(test: &str) -> Option<std::path::PathBuf> {
         }
     }
 }
+
+/// A fresh, empty scratch folder `area/name` under Cargo's per-target temporary directory
+/// (kept after the run for inspection, emptied at the next).
+pub fn scratch(area: &str, name: &str) -> std::path::PathBuf {
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(area)
+        .join(name);
+    if dir.exists() {
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `f` run on a rayon pool of `threads` threads (results must not depend on the count).
+pub fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap()
+        .install(f)
+}
+
+/// A proptest configuration of `cases` cases from the fixed `seed` (the same cases on every
+/// run) that writes no failure-persistence files.
+pub fn fixed_cases(cases: u32, seed: u64) -> proptest::test_runner::Config {
+    proptest::test_runner::Config {
+        cases,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(seed),
+        failure_persistence: None,
+        ..proptest::test_runner::Config::default()
+    }
+}
