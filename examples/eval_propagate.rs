@@ -40,7 +40,10 @@
 //! and rigid, only parts and rigid, none), and with several sources each route's held-out
 //! accuracy on the sources. With `COSEG_DUMP=DIR`, every run writes every route's labels and
 //! confidences on every target and the held-out runs to `DIR/run-<sources>.json` (the shapes'
-//! areas and per-vertex ground truth to `DIR/shapes.json`), for replaying fusion rules offline.
+//! areas and per-vertex ground truth to `DIR/shapes.json`), for replaying fusion rules offline;
+//! each target also gets every source's registration candidates (residual, angle, the labels
+//! carried by the similarity and by its affine relaxation), and each run the co-segmentation's
+//! part ids of every shape and whether the parts read the intrinsic family alone.
 //! Accuracy is area-weighted: per face against `.seg` files for the chairs, per vertex for
 //! the identity sets; the source shapes are left out of every mean.
 
@@ -78,6 +81,8 @@ struct Set {
     parts: Mutex<CollectionParts>,
     /// Per route (and "fused"), the mean accuracy of every run, in run order.
     route_log: Mutex<BTreeMap<String, Vec<(usize, f64)>>>,
+    /// `COSEG_DUMP`: registrations `(source, target)` of every candidate pose, computed so far.
+    dump_regs: Mutex<HashMap<(usize, usize), Registration>>,
 }
 
 fn load(
@@ -136,6 +141,7 @@ fn load(
         routes: routes.clone(),
         parts: Mutex::new(parts),
         route_log: Mutex::new(BTreeMap::new()),
+        dump_regs: Mutex::new(HashMap::new()),
     })
 }
 
@@ -306,6 +312,7 @@ fn dump_run(
                 .collect();
             json!({
                 "shape": i,
+                "candidates": candidates(set, sources, annotation, i),
                 "routes": routes,
                 "fused_score": score(i, &p.labels[i]),
                 "weights": report.fused.weights[i],
@@ -327,12 +334,72 @@ fn dump_run(
         .map(|(r, _)| r.name().to_string())
         .collect();
     let tag: Vec<String> = sources.iter().map(|s| s.to_string()).collect();
-    let v = json!({"sources": sources, "routes": names, "targets": targets, "held_out": held});
+    let (parts, intrinsic): (Vec<Vec<i32>>, Option<bool>) = {
+        let mut cp = set.parts.lock().unwrap();
+        let parts = match cp.parts(p.parts.len(), &set.meshes) {
+            Ok(seg) => (0..n).map(|i| seg.labels(i)).collect(),
+            Err(_) => Vec::new(),
+        };
+        (parts, cp.intrinsic_only(p.parts.len()))
+    };
+    let v = json!({"sources": sources, "routes": names, "targets": targets, "held_out": held,
+                   "part_ids": parts, "parts_intrinsic": intrinsic});
     std::fs::write(
         dir.join(format!("run-{}.json", tag.join("-"))),
         serde_json::to_string(&v)?,
     )?;
     Ok(())
+}
+
+/// `COSEG_DUMP`: every candidate pose of the registration of target `i` onto each source,
+/// with its residual and the labels it carries (similarity, and relaxed to affine as the
+/// rigid route does).
+fn candidates(
+    set: &Set,
+    sources: &[usize],
+    annotation: &dyn Fn(usize) -> Vec<i32>,
+    i: usize,
+) -> serde_json::Value {
+    use coseg::align::{Similarity, SurfaceIndex};
+    use serde_json::json;
+    let mut out = Vec::new();
+    for &s in sources {
+        let cached = set.dump_regs.lock().unwrap().get(&(s, i)).cloned();
+        let reg = match cached {
+            Some(r) => r,
+            None => {
+                match register_pair(&set.meshes[s], &set.meshes[i], &RegisterOptions::default()) {
+                    Ok(r) => {
+                        set.dump_regs.lock().unwrap().insert((s, i), r.clone());
+                        r
+                    }
+                    Err(_) => continue,
+                }
+            }
+        };
+        let ann = annotation(s);
+        let index = SurfaceIndex::new(&set.meshes[s]);
+        let cands: Vec<serde_json::Value> = reg
+            .candidates
+            .par_iter()
+            .map(|c| {
+                let sim = nearest_point_vertex_labels(&set.meshes[s], &ann, &set.meshes[i], &c.transform)
+                    .map(|x| x.0)
+                    .unwrap_or_default();
+                let fit = coseg::propagate::refine_affine(&set.meshes[s], &index, &set.meshes[i], &c.transform, 0.9);
+                let aff = set.meshes[i]
+                    .map_positions(|p| fit.map.apply(p))
+                    .ok()
+                    .and_then(|m| nearest_point_vertex_labels(&set.meshes[s], &ann, &m, &Similarity::identity()).ok())
+                    .map(|x| x.0)
+                    .unwrap_or_default();
+                json!({"residual": c.residual, "angle": c.angle_to_best, "labels": sim, "affine": aff,
+                       "affine_residual": fit.residual, "affine_start": fit.start_residual})
+            })
+            .collect();
+        out.push(json!({"source": s, "inlier_share": reg.inlier_share, "candidates": cands}));
+    }
+    json!(out)
 }
 
 /// Prints each logged route's mean over the runs and its worst run, then clears the log.

@@ -1,10 +1,10 @@
 //! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
 
 use super::held_out::{HeldOutInputs, held_out_routes_cached};
-use super::rigid_route::rigid_route_cached;
+use super::rigid_route::{choose_alternatives, rigid_alternatives_cached};
 use super::{
     FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
-    fuse_routes_with, parts_route, snap_labels,
+    choose_rigid_alternative, fuse_routes_with, parts_route, rigid_choice_is_outlier, snap_labels,
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
@@ -237,17 +237,69 @@ pub fn fuse_propagation(
                 .push(format!("parts route off: the co-segmentation failed: {e}")),
         }
     }
+    // The rigid route's other poses and sources are weighed only against routes that fail
+    // independently: parts from the intrinsic family share the affinity's mirror confusions
+    // (`choose_rigid_alternative`).
+    let rigid_poses = segmentation.is_some() && !parts_intrinsic;
     if options.rigid {
         let targets: Vec<usize> = (0..n).filter(|&i| annotations[i].is_none()).collect();
-        let (rigid, warnings) = rigid_route_cached(
+        let (mut alternatives, warnings) = rigid_alternatives_cached(
             meshes,
             annotations,
             options.affine,
             &targets,
             &propagation.rigid,
+            false,
         );
         report.warnings.extend(warnings);
-        report.routes.push((Route::Rigid, rigid));
+        let others = |i: usize| -> Vec<&[i32]> {
+            report
+                .routes
+                .iter()
+                .filter(|(_, r)| r.votes_on(i))
+                .map(|(_, r)| r.labels[i].as_slice())
+                .collect()
+        };
+        // The other poses and sources are carried only where the registration's choice is the
+        // outlier among the routes (`choose_rigid_alternative`): elsewhere they could not be
+        // taken, and carrying each costs an affine fit.
+        let outliers: Vec<usize> = targets
+            .iter()
+            .copied()
+            .filter(|&i| {
+                rigid_poses
+                    && alternatives[i]
+                        .first()
+                        .is_some_and(|a| rigid_choice_is_outlier(&a.labels, &others(i), areas[i]))
+            })
+            .collect();
+        if !outliers.is_empty() {
+            let (more, _) = rigid_alternatives_cached(
+                meshes,
+                annotations,
+                options.affine,
+                &outliers,
+                &propagation.rigid,
+                true,
+            );
+            for (i, m) in more.into_iter().enumerate() {
+                if !m.is_empty() {
+                    alternatives[i] = m;
+                }
+            }
+        }
+        let chosen: Vec<usize> = (0..n)
+            .map(|i| {
+                let alts: Vec<&[i32]> = alternatives[i]
+                    .iter()
+                    .map(|a| a.labels.as_slice())
+                    .collect();
+                choose_rigid_alternative(&alts, &others(i), areas[i])
+            })
+            .collect();
+        report
+            .routes
+            .push((Route::Rigid, choose_alternatives(alternatives, &chosen)));
     }
     let names: Vec<Route> = report.routes.iter().map(|(r, _)| *r).collect();
     let held_out = HeldOutInputs {
@@ -260,7 +312,7 @@ pub fn fuse_propagation(
         segmentation,
         affine: options.affine,
     };
-    report.held_out_runs = held_out_routes_cached(&held_out, &propagation.rigid)?;
+    report.held_out_runs = held_out_routes_cached(&held_out, &propagation.rigid, rigid_poses)?;
     report.held_out = report.held_out_runs.as_ref().map(|h| h.accuracy.clone());
     let refs: Vec<&RouteLabels> = report.routes.iter().map(|(_, r)| r).collect();
     // The band affinity and the parts route fail together where both read the intrinsic

@@ -288,45 +288,53 @@ pub fn fuse_routes_with(
 /// routes on shape `i`, as an `m × m` matrix (diagonal 1).
 fn pair_kappa(routes: &[&RouteLabels], voting: &[usize], i: usize, areas: &[f64]) -> Vec<Vec<f64>> {
     let m = voting.len();
-    let total: f64 = areas.iter().sum::<f64>().max(f64::MIN_POSITIVE);
-    let shares: Vec<BTreeMap<i32, f64>> = voting
-        .iter()
-        .map(|&r| {
-            let mut s = BTreeMap::new();
-            for (&l, &w) in routes[r].labels[i].iter().zip(areas) {
-                if l >= 0 {
-                    *s.entry(l).or_insert(0.0) += w / total;
-                }
-            }
-            s
-        })
-        .collect();
     let mut k = vec![vec![1.0; m]; m];
     for x in 0..m {
         for y in x + 1..m {
-            let (lx, ly) = (&routes[voting[x]].labels[i], &routes[voting[y]].labels[i]);
-            let agree: f64 = lx
-                .iter()
-                .zip(ly)
-                .zip(areas)
-                .filter(|((p, q), _)| **p >= 0 && p == q)
-                .map(|(_, w)| w)
-                .sum::<f64>()
-                / total;
-            let chance: f64 = shares[x]
-                .iter()
-                .map(|(l, s)| s * shares[y].get(l).copied().unwrap_or(0.0))
-                .sum();
-            let kappa = if chance < 1.0 {
-                (agree - chance) / (1.0 - chance)
-            } else {
-                0.0
-            };
+            let kappa = cohen_kappa(
+                &routes[voting[x]].labels[i],
+                &routes[voting[y]].labels[i],
+                areas,
+            );
             k[x][y] = kappa;
             k[y][x] = kappa;
         }
     }
     k
+}
+
+/// Cohen's κ of two labellings of one shape, over its area: `(a − e) / (1 − e)`, `a` the area
+/// share where both give the same label (`< 0` is no label and agrees with nothing), `e` the
+/// share expected from their label shares alone; 0 where `e = 1`.
+pub(crate) fn cohen_kappa(x: &[i32], y: &[i32], areas: &[f64]) -> f64 {
+    let total: f64 = areas.iter().sum::<f64>().max(f64::MIN_POSITIVE);
+    let shares = |l: &[i32]| {
+        let mut s = BTreeMap::new();
+        for (&l, &w) in l.iter().zip(areas) {
+            if l >= 0 {
+                *s.entry(l).or_insert(0.0) += w / total;
+            }
+        }
+        s
+    };
+    let (sx, sy) = (shares(x), shares(y));
+    let agree: f64 = x
+        .iter()
+        .zip(y)
+        .zip(areas)
+        .filter(|((p, q), _)| **p >= 0 && p == q)
+        .map(|(_, w)| w)
+        .sum::<f64>()
+        / total;
+    let chance: f64 = sx
+        .iter()
+        .map(|(l, s)| s * sy.get(l).copied().unwrap_or(0.0))
+        .sum();
+    if chance < 1.0 {
+        (agree - chance) / (1.0 - chance)
+    } else {
+        0.0
+    }
 }
 
 /// Each voting route's accuracy above chance `κ_r` from the pairwise κ (see

@@ -1,8 +1,11 @@
 //! [`held_out_accuracy`]: each route's accuracy measured on the sources themselves, every
 //! source's labels carried to it from the other sources.
 
-use super::rigid_route::{RigidCache, rigid_route_cached};
-use super::{PropagateError, PropagateOptions, Route, parts_route, propagate_labels};
+use super::rigid_route::{RigidCache, rigid_alternatives_cached};
+use super::{
+    PropagateError, PropagateOptions, Route, choose_rigid_alternative, parts_route,
+    propagate_labels, rigid_choice_is_outlier,
+};
 use crate::graph::{Cosegmentation, ShapeGraph};
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -75,14 +78,17 @@ pub struct HeldOutRoutes {
 /// [`held_out_accuracy`] with every held-out run's labels ([`HeldOutRoutes`]); same inputs
 /// and errors.
 pub fn held_out_routes(inputs: &HeldOutInputs) -> Result<Option<HeldOutRoutes>, PropagateError> {
-    held_out_routes_cached(inputs, &RigidCache::default())
+    held_out_routes_cached(inputs, &RigidCache::default(), false)
 }
 
 /// [`held_out_routes`] with the rigid route's registrations kept in `rigid` (the fusion
-/// shares its propagation's cache, whose pairs of sources the held-out runs need).
+/// shares its propagation's cache, whose pairs of sources the held-out runs need) and, with
+/// `rigid_poses`, the rigid route's pose chosen among its alternatives as the fusion chooses
+/// it ([`choose_rigid_alternative`] against the routes scored before it).
 pub(crate) fn held_out_routes_cached(
     inputs: &HeldOutInputs,
     rigid: &RigidCache,
+    rigid_poses: bool,
 ) -> Result<Option<HeldOutRoutes>, PropagateError> {
     let HeldOutInputs {
         graph,
@@ -145,8 +151,33 @@ pub(crate) fn held_out_routes_cached(
                     None => (Vec::new(), Vec::new(), f64::NAN),
                 },
                 Route::Rigid => {
-                    let r = rigid_route_cached(meshes, &ann, affine, &[s], rigid).0;
-                    (r.labels[s].clone(), r.confidence[s].clone(), r.residual[s])
+                    // As the fusion takes it: the pose the routes before it agree with.
+                    let others: Vec<&[i32]> = labels
+                        .iter()
+                        .filter(|l: &&Vec<i32>| !l.is_empty())
+                        .map(|l| l.as_slice())
+                        .collect();
+                    let mut alts =
+                        rigid_alternatives_cached(meshes, &ann, affine, &[s], rigid, false)
+                            .0
+                            .swap_remove(s);
+                    if rigid_poses
+                        && alts
+                            .first()
+                            .is_some_and(|a| rigid_choice_is_outlier(&a.labels, &others, areas[s]))
+                    {
+                        alts = rigid_alternatives_cached(meshes, &ann, affine, &[s], rigid, true)
+                            .0
+                            .swap_remove(s);
+                    }
+                    let options: Vec<&[i32]> = alts.iter().map(|a| a.labels.as_slice()).collect();
+                    let k = choose_rigid_alternative(&options, &others, areas[s]);
+                    if alts.is_empty() {
+                        (Vec::new(), Vec::new(), f64::NAN)
+                    } else {
+                        let a = alts.swap_remove(k);
+                        (a.labels, a.confidence, a.residual)
+                    }
                 }
             };
             scores.push(score(&l));

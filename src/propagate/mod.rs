@@ -45,7 +45,10 @@ pub use options::PropagateOptions;
 pub use part_scores::PartScore;
 pub use parts_route::parts_route;
 pub use refine_affine::{AffineFit, AffineMap, refine_affine};
-pub use rigid_route::rigid_route;
+pub use rigid_route::{
+    RigidAlternative, choose_rigid_alternative, rigid_alternatives, rigid_choice_is_outlier,
+    rigid_route,
+};
 pub use snap_labels::snap_labels;
 pub use solve::{Propagation, UpdateStats, propagate_labels};
 

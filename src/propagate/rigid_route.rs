@@ -2,10 +2,11 @@
 //! surface point.
 
 use super::RouteLabels;
+use super::fuse_routes::cohen_kappa;
 use super::refine_affine::refine_affine;
 use crate::align::{
-    RegisterOptions, Registration, Similarity, SurfaceIndex, nearest_point_vertex_labels,
-    register_pair,
+    Candidate, RegisterOptions, Registration, Similarity, SurfaceIndex,
+    nearest_point_vertex_labels, register_pair,
 };
 use crate::mesh::TriMesh;
 use rayon::prelude::*;
@@ -57,15 +58,15 @@ pub(crate) fn rigid_route_to(
 }
 
 /// What the rigid route learns of one (source, target) pair that does not depend on the
-/// labels: the registration and, once the pair was chosen, which source vertex each target
-/// vertex reads its label from.
+/// labels: the registration and, per pose it was read through, which source vertex each
+/// target vertex reads its label from.
 #[derive(Debug, Clone)]
 struct PairFit {
     /// The registration, or why it failed.
     registration: Result<Registration, String>,
-    /// Per target vertex: the source vertex whose label it takes and how far it lands from the
-    /// source's surface; made on the first call that chooses this source.
-    nearest: Option<Nearest>,
+    /// Per candidate pose of the registration (its index in [`Registration::candidates`]): the
+    /// source vertex of every target vertex; made on the first call that reads this pose.
+    nearest: BTreeMap<usize, Nearest>,
 }
 
 /// Per target vertex the source vertex it reads and its distance to the source's surface, and
@@ -74,9 +75,9 @@ type Nearest = (Vec<i32>, Vec<f64>, f64);
 
 /// The rigid route's label-independent work, kept between propagations of one collection:
 /// per (source, target) pair the registration and the nearest source vertex of every target
-/// vertex. A change of labels then costs one table look-up per vertex instead of a
-/// registration and a nearest-point search per pair. Results are those of an empty cache, bit
-/// for bit: what is kept is exactly what would be recomputed.
+/// vertex under each of its poses. A change of labels then costs one table look-up per vertex
+/// instead of a registration and a nearest-point search per pair. Results are those of an
+/// empty cache, bit for bit: what is kept is exactly what would be recomputed.
 ///
 /// Entries are keyed by the shapes' indices and vertex counts and the affine step; a cache
 /// serves one collection of meshes (a [`super::Propagation`] keeps one for its graph).
@@ -138,43 +139,48 @@ impl RigidCache {
             .entry(key)
             .or_insert(PairFit {
                 registration,
-                nearest: None,
+                nearest: BTreeMap::new(),
             })
             .registration
             .clone()
     }
 
     /// Per vertex of target `i`: the vertex of source `s` it reads its label from and its
-    /// distance to the source's surface, after `reg` (and the affine step); computed on the
-    /// first call.
+    /// distance to the source's surface, after the registration's candidate pose `pose` (and
+    /// the affine step); computed on the first call.
     fn nearest(
         &self,
         meshes: &[TriMesh],
         s: usize,
         i: usize,
         affine: bool,
-        reg: &Registration,
+        pose: &Candidate,
+        index_of_pose: usize,
     ) -> Result<Nearest, String> {
         let key = Self::key(meshes, s, i, affine);
-        if let Some(n) = self.lock().get(&key).and_then(|f| f.nearest.clone()) {
+        if let Some(n) = self
+            .lock()
+            .get(&key)
+            .and_then(|f| f.nearest.get(&index_of_pose).cloned())
+        {
             return Ok(n);
         }
         // The source's vertex indices as its labels: the nearest-point rule gives each target
         // vertex the index of the vertex whose label it would read.
         let index: Vec<i32> = (0..meshes[s].vertex_count() as i32).collect();
-        let mut residual = reg.residual;
+        let mut residual = pose.residual;
         let carried = if affine {
             let fit = refine_affine(
                 &meshes[s],
                 &SurfaceIndex::new(&meshes[s]),
                 &meshes[i],
-                &reg.transform,
+                &pose.transform,
                 AFFINE_TRIM,
             );
             if fit.start_residual > 0.0 && fit.residual.is_finite() {
                 // The affine fit measures the same chamfer in source units: rescale its
                 // improvement onto the registration's residual.
-                residual = reg.residual * (fit.residual / fit.start_residual).min(1.0);
+                residual = pose.residual * (fit.residual / fit.start_residual).min(1.0);
             }
             match meshes[i].map_positions(|p| fit.map.apply(p)) {
                 Ok(mapped) => nearest_point_vertex_labels(
@@ -184,22 +190,24 @@ impl RigidCache {
                     &Similarity::identity(),
                 ),
                 Err(_) => {
-                    nearest_point_vertex_labels(&meshes[s], &index, &meshes[i], &reg.transform)
+                    nearest_point_vertex_labels(&meshes[s], &index, &meshes[i], &pose.transform)
                 }
             }
         } else {
-            nearest_point_vertex_labels(&meshes[s], &index, &meshes[i], &reg.transform)
+            nearest_point_vertex_labels(&meshes[s], &index, &meshes[i], &pose.transform)
         }
         .map(|(v, d)| (v, d, residual))
         .map_err(|e| e.to_string())?;
         if let Some(f) = self.lock().get_mut(&key) {
-            f.nearest = Some(carried.clone());
+            f.nearest.insert(index_of_pose, carried.clone());
         }
         Ok(carried)
     }
 }
 
-/// [`rigid_route_to`] keeping the label-independent work in `cache`.
+/// [`rigid_route_to`] keeping the label-independent work in `cache`: every target's first
+/// alternative of [`rigid_alternatives_cached`] (the source it registers best onto, the
+/// registration's best pose).
 pub(crate) fn rigid_route_cached(
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
@@ -207,68 +215,176 @@ pub(crate) fn rigid_route_cached(
     targets: &[usize],
     cache: &RigidCache,
 ) -> (RouteLabels, Vec<String>) {
+    let (alternatives, warnings) =
+        rigid_alternatives_cached(meshes, annotations, affine, targets, cache, false);
+    let chosen: Vec<usize> = vec![0; meshes.len()];
+    (choose_alternatives(alternatives, &chosen), warnings)
+}
+
+/// One way the rigid route can carry the labels onto a shape: a source and one locally
+/// optimal pose of the shape on it ([`Registration::candidates`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RigidAlternative {
+    /// The source (graph order).
+    pub source: usize,
+    /// The pose: its index in the registration's candidates (0: the lowest residual).
+    pub pose: usize,
+    /// Per vertex: the label of the nearest source surface point under the pose (relaxed to
+    /// affine with the route's affine step).
+    pub labels: Vec<i32>,
+    /// Per vertex: `1 / (1 + d / ρ)` ([`rigid_route`]).
+    pub confidence: Vec<f64>,
+    /// The registration's inlier share (at its best pose).
+    pub inlier_share: f64,
+    /// The symmetric trimmed chamfer of the pose (after the affine step), in source RMS
+    /// radii.
+    pub residual: f64,
+}
+
+/// Every way the rigid route can carry the labels onto each unlabelled shape (graph order;
+/// empty on the sources and where no registration succeeded): per source, per distinct pose
+/// of the registration onto it ([`Registration::candidates`]). The route's own choice comes
+/// first (the source the shape registers best onto, its best pose), then the other sources'
+/// best poses by residual, then every source's other poses in its registration's order.
+/// With `all = false`, the route's own choice alone ([`rigid_route`]).
+///
+/// Why: a registration's poses of nearly equal residual are the geometry's own ambiguity (a
+/// humanoid turned about its axis, a goblet upside down): the residual cannot choose among
+/// them, and the fusion lets the other routes do it ([`super::fuse_propagation`]).
+/// Cost: one affine fit and nearest-point search per (source, pose), up to four poses.
+pub fn rigid_alternatives(
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    affine: bool,
+    all: bool,
+) -> (Vec<Vec<RigidAlternative>>, Vec<String>) {
+    let targets: Vec<usize> = (0..meshes.len())
+        .filter(|&i| annotations[i].is_none())
+        .collect();
+    rigid_alternatives_cached(
+        meshes,
+        annotations,
+        affine,
+        &targets,
+        &RigidCache::default(),
+        all,
+    )
+}
+
+/// [`rigid_alternatives`] on the shapes `targets`, keeping the label-independent work in
+/// `cache`.
+pub(crate) fn rigid_alternatives_cached(
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    affine: bool,
+    targets: &[usize],
+    cache: &RigidCache,
+    all: bool,
+) -> (Vec<Vec<RigidAlternative>>, Vec<String>) {
     let n = meshes.len();
     let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
-    type Carried = Result<(Vec<i32>, Vec<f64>, f64, f64), String>;
+    type Carried = Result<Vec<RigidAlternative>, String>;
     let results: Vec<Option<Carried>> = (0..n)
         .into_par_iter()
         .map(|i| {
             if annotations[i].is_some() || !targets.contains(&i) {
                 return None;
             }
-            let mut best: Option<(f64, usize, Registration)> = None;
+            let mut registered: Vec<(usize, Registration)> = Vec::new();
             let mut error = String::new();
             for &s in &sources {
                 match cache.registration(meshes, s, i, affine) {
-                    Ok(r) => {
-                        if best.as_ref().is_none_or(|b| r.residual < b.0) {
-                            best = Some((r.residual, s, r));
-                        }
-                    }
+                    Ok(r) => registered.push((s, r)),
                     Err(e) => error = e,
                 }
             }
-            let Some((_, s, reg)) = best else {
+            if registered.is_empty() {
                 return Some(Err(error));
-            };
-            let ann = annotations[s].as_deref().unwrap_or_default();
-            let radius = rms_radius(&meshes[s]);
-            if ann.len() != meshes[s].vertex_count() {
-                return Some(Err(crate::align::AlignError::LabelCount {
-                    expected: meshes[s].vertex_count(),
-                    found: ann.len(),
-                    kind: "vertex",
-                }
-                .to_string()));
             }
-            Some(
-                cache
-                    .nearest(meshes, s, i, affine, &reg)
-                    .map(|(from, dist, residual)| {
+            // Stable: equal residuals keep the sources' order, as the route always did.
+            registered.sort_by(|a, b| a.1.residual.total_cmp(&b.1.residual));
+            let mut wanted: Vec<(usize, usize)> = vec![(0, 0)];
+            if all {
+                wanted.extend((1..registered.len()).map(|k| (k, 0)));
+                for (k, (_, r)) in registered.iter().enumerate() {
+                    wanted.extend((1..r.candidates.len()).map(|c| (k, c)));
+                }
+            }
+            let mut out = Vec::with_capacity(wanted.len());
+            for (k, c) in wanted {
+                let (s, reg) = &registered[k];
+                let s = *s;
+                let ann = annotations[s].as_deref().unwrap_or_default();
+                if ann.len() != meshes[s].vertex_count() {
+                    return Some(Err(crate::align::AlignError::LabelCount {
+                        expected: meshes[s].vertex_count(),
+                        found: ann.len(),
+                        kind: "vertex",
+                    }
+                    .to_string()));
+                }
+                let first = Candidate {
+                    transform: reg.transform,
+                    residual: reg.residual,
+                    angle_to_best: 0.0,
+                };
+                let pose = reg.candidates.get(c).unwrap_or(&first);
+                let radius = rms_radius(&meshes[s]);
+                match cache.nearest(meshes, s, i, affine, pose, c) {
+                    Ok((from, dist, residual)) => {
                         let labels = from.iter().map(|&v| ann[v as usize]).collect();
                         // The residual is in source RMS radii; the distances in source units.
-                        let scale = radius * reg.residual.max(f64::EPSILON);
-                        let conf = dist.iter().map(|d| 1.0 / (1.0 + d / scale)).collect();
-                        (labels, conf, reg.inlier_share, residual)
-                    }),
-            )
+                        let scale = radius * pose.residual.max(f64::EPSILON);
+                        let confidence = dist.iter().map(|d| 1.0 / (1.0 + d / scale)).collect();
+                        out.push(RigidAlternative {
+                            source: s,
+                            pose: c,
+                            labels,
+                            confidence,
+                            inlier_share: reg.inlier_share,
+                            residual,
+                        });
+                    }
+                    Err(e) if out.is_empty() => return Some(Err(e)),
+                    Err(_) => {}
+                }
+            }
+            Some(Ok(out))
         })
         .collect();
-    let mut out = RouteLabels::empty(n);
+    let mut out = vec![Vec::new(); n];
     let mut warnings = Vec::new();
     for (i, r) in results.into_iter().enumerate() {
         match r {
             None => {}
-            Some(Ok((labels, conf, share, residual))) => {
-                out.labels[i] = labels;
-                out.confidence[i] = conf;
-                out.shape_confidence[i] = share;
-                out.residual[i] = residual;
-            }
+            Some(Ok(a)) => out[i] = a,
             Some(Err(e)) => warnings.push(format!("rigid route: shape {i} not registered: {e}")),
         }
     }
     (out, warnings)
+}
+
+/// The rigid route's labels on every shape from its alternatives: on shape `i` the
+/// alternative `chosen[i]` (the first where `chosen[i]` is out of range).
+pub(crate) fn choose_alternatives(
+    alternatives: Vec<Vec<RigidAlternative>>,
+    chosen: &[usize],
+) -> RouteLabels {
+    let mut out = RouteLabels::empty(alternatives.len());
+    for (i, alts) in alternatives.into_iter().enumerate() {
+        let k = chosen
+            .get(i)
+            .copied()
+            .filter(|&k| k < alts.len())
+            .unwrap_or(0);
+        if let Some(a) = alts.into_iter().nth(k) {
+            out.labels[i] = a.labels;
+            out.confidence[i] = a.confidence;
+            out.shape_confidence[i] = a.inlier_share;
+            out.residual[i] = a.residual;
+        }
+    }
+    out
 }
 
 /// Share of the nearest-point pairs (by area, each direction) the affine fit keeps: the
@@ -293,4 +409,93 @@ fn rms_radius(mesh: &TriMesh) -> f64 {
         .map(|(x, a)| a * (0..3).map(|k| (x[k] - c[k]).powi(2)).sum::<f64>())
         .sum();
     (s / total).sqrt()
+}
+
+/// Which of one shape's rigid alternatives ([`rigid_alternatives`], the route's own choice
+/// first) the fusion takes, given the labels of other routes that fail independently of each
+/// other on the shape (`others`, each as long as `areas`; a route that says nothing there is
+/// left out). The route's own choice stands unless
+///
+/// 1. it is the outlier: it agrees with each other route less than every two other routes
+///    agree with each other (Cohen's κ over the area; under the one-coin model of
+///    [`super::fuse_routes`] `κ_rq = κ_r κ_q`, so this says the registration's choice is
+///    estimated less accurate than every other route), and
+/// 2. another alternative agrees better with *every* other route (each κ strictly higher);
+///
+/// then the alternative with the highest κ sum is taken (ties: the earliest). With fewer than
+/// two other routes the own choice stands.
+///
+/// Why: a pose the geometry cannot tell from the best one (residuals within a few percent: a
+/// humanoid turned about its axis, measured in docs/PROPAGATION.md) is wrong on most of the
+/// shape, and every independent correspondence says so at once. Where the registration's
+/// choice agrees with the others as well as they agree among themselves it is not collapsed,
+/// and a pose the others prefer by a hair shares their errors rather than fixes its own (a
+/// COSEG chair, 95.3 % right, replaced by a pose right on 90.5 %); a pose preferred by one
+/// route alone shares that route's error (the parts' seam a little off). Routes that fail
+/// together (the band affinity and parts both read from the intrinsic family, which confuse
+/// a part with its mirror image alike) are one piece of evidence, not two: the caller passes
+/// them only where they do not share their features. No threshold: every comparison is
+/// between agreements on the same shape.
+///
+/// Output: an index into `alternatives` (0 with fewer than two other routes or a single
+/// alternative).
+pub fn choose_rigid_alternative(
+    alternatives: &[&[i32]],
+    others: &[&[i32]],
+    areas: &[f64],
+) -> usize {
+    let others: Vec<&[i32]> = others
+        .iter()
+        .copied()
+        .filter(|o| o.len() == areas.len() && o.iter().any(|&l| l >= 0))
+        .collect();
+    if others.len() < 2 || alternatives.len() < 2 {
+        return 0;
+    }
+    let agreement = |labels: &[i32]| -> Vec<f64> {
+        others
+            .iter()
+            .map(|o| cohen_kappa(labels, o, areas))
+            .collect()
+    };
+    if !rigid_choice_is_outlier(alternatives[0], &others, areas) {
+        return 0;
+    }
+    let own = agreement(alternatives[0]);
+    let mut best = (own.iter().sum::<f64>(), 0);
+    for (k, alt) in alternatives.iter().enumerate().skip(1) {
+        if alt.len() != areas.len() {
+            continue;
+        }
+        let a = agreement(alt);
+        let sum: f64 = a.iter().sum();
+        if a.iter().zip(&own).all(|(x, y)| x > y) && sum > best.0 {
+            best = (sum, k);
+        }
+    }
+    best.1
+}
+
+/// Whether the rigid route's own labels on a shape (`own`) are the outlier among the routes:
+/// they agree with each of the `others` (routes that fail independently; each as long as
+/// `areas`, a route that says nothing there left out) less than every two of those agree with
+/// each other (Cohen's κ over the area). The first test of [`choose_rigid_alternative`], cheap
+/// enough to run before the other poses are carried at all. False with fewer than two other
+/// routes.
+pub fn rigid_choice_is_outlier(own: &[i32], others: &[&[i32]], areas: &[f64]) -> bool {
+    let others: Vec<&[i32]> = others
+        .iter()
+        .copied()
+        .filter(|o| o.len() == areas.len() && o.iter().any(|&l| l >= 0))
+        .collect();
+    if others.len() < 2 || own.len() != areas.len() {
+        return false;
+    }
+    let mut among = f64::INFINITY;
+    for (x, a) in others.iter().enumerate() {
+        for b in &others[x + 1..] {
+            among = among.min(cohen_kappa(a, b, areas));
+        }
+    }
+    others.iter().all(|o| cohen_kappa(own, o, areas) < among)
 }
