@@ -1,10 +1,10 @@
 //! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
 
 use super::held_out::{HeldOutInputs, held_out_routes_cached};
-use super::rigid_route::{choose_alternatives, rigid_alternatives_cached};
+use super::rigid_route::rigid_route_weighed;
 use super::{
     FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
-    choose_rigid_alternative, fuse_routes_with, parts_route, rigid_choice_is_outlier, snap_labels,
+    fuse_routes_with, parts_route, snap_labels,
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
@@ -243,63 +243,25 @@ pub fn fuse_propagation(
     let rigid_poses = segmentation.is_some() && !parts_intrinsic;
     if options.rigid {
         let targets: Vec<usize> = (0..n).filter(|&i| annotations[i].is_none()).collect();
-        let (mut alternatives, warnings) = rigid_alternatives_cached(
+        let (rigid, warnings) = rigid_route_weighed(
             meshes,
             annotations,
             options.affine,
             &targets,
             &propagation.rigid,
-            false,
+            rigid_poses,
+            |i| {
+                report
+                    .routes
+                    .iter()
+                    .filter(|(_, r)| r.votes_on(i))
+                    .map(|(_, r)| r.labels[i].as_slice())
+                    .collect()
+            },
+            &areas,
         );
         report.warnings.extend(warnings);
-        let others = |i: usize| -> Vec<&[i32]> {
-            report
-                .routes
-                .iter()
-                .filter(|(_, r)| r.votes_on(i))
-                .map(|(_, r)| r.labels[i].as_slice())
-                .collect()
-        };
-        // The other poses and sources are carried only where the registration's choice is the
-        // outlier among the routes (`choose_rigid_alternative`): elsewhere they could not be
-        // taken, and carrying each costs an affine fit.
-        let outliers: Vec<usize> = targets
-            .iter()
-            .copied()
-            .filter(|&i| {
-                rigid_poses
-                    && alternatives[i]
-                        .first()
-                        .is_some_and(|a| rigid_choice_is_outlier(&a.labels, &others(i), areas[i]))
-            })
-            .collect();
-        if !outliers.is_empty() {
-            let (more, _) = rigid_alternatives_cached(
-                meshes,
-                annotations,
-                options.affine,
-                &outliers,
-                &propagation.rigid,
-                true,
-            );
-            for (i, m) in more.into_iter().enumerate() {
-                if !m.is_empty() {
-                    alternatives[i] = m;
-                }
-            }
-        }
-        let chosen: Vec<usize> = (0..n)
-            .map(|i| {
-                let alts: Vec<&[i32]> = alternatives[i]
-                    .iter()
-                    .map(|a| a.labels.as_slice())
-                    .collect();
-                choose_rigid_alternative(&alts, &others(i), areas[i])
-            })
-            .collect();
-        report
-            .routes
-            .push((Route::Rigid, choose_alternatives(alternatives, &chosen)));
+        report.routes.push((Route::Rigid, rigid));
     }
     let names: Vec<Route> = report.routes.iter().map(|(r, _)| *r).collect();
     let held_out = HeldOutInputs {

@@ -1,11 +1,8 @@
 //! [`held_out_accuracy`]: each route's accuracy measured on the sources themselves, every
 //! source's labels carried to it from the other sources.
 
-use super::rigid_route::{RigidCache, rigid_alternatives_cached};
-use super::{
-    PropagateError, PropagateOptions, Route, choose_rigid_alternative, parts_route,
-    propagate_labels, rigid_choice_is_outlier,
-};
+use super::rigid_route::{RigidCache, rigid_route_weighed};
+use super::{PropagateError, PropagateOptions, Route, parts_route, propagate_labels};
 use crate::graph::{Cosegmentation, ShapeGraph};
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -157,27 +154,22 @@ pub(crate) fn held_out_routes_cached(
                         .filter(|l: &&Vec<i32>| !l.is_empty())
                         .map(|l| l.as_slice())
                         .collect();
-                    let mut alts =
-                        rigid_alternatives_cached(meshes, &ann, affine, &[s], rigid, false)
-                            .0
-                            .swap_remove(s);
-                    if rigid_poses
-                        && alts
-                            .first()
-                            .is_some_and(|a| rigid_choice_is_outlier(&a.labels, &others, areas[s]))
-                    {
-                        alts = rigid_alternatives_cached(meshes, &ann, affine, &[s], rigid, true)
-                            .0
-                            .swap_remove(s);
-                    }
-                    let options: Vec<&[i32]> = alts.iter().map(|a| a.labels.as_slice()).collect();
-                    let k = choose_rigid_alternative(&options, &others, areas[s]);
-                    if alts.is_empty() {
-                        (Vec::new(), Vec::new(), f64::NAN)
-                    } else {
-                        let a = alts.swap_remove(k);
-                        (a.labels, a.confidence, a.residual)
-                    }
+                    let mut r = rigid_route_weighed(
+                        meshes,
+                        &ann,
+                        affine,
+                        &[s],
+                        rigid,
+                        rigid_poses,
+                        |_| others.clone(),
+                        &areas,
+                    )
+                    .0;
+                    (
+                        std::mem::take(&mut r.labels[s]),
+                        std::mem::take(&mut r.confidence[s]),
+                        r.residual[s],
+                    )
                 }
             };
             scores.push(score(&l));

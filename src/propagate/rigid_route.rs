@@ -221,6 +221,58 @@ pub(crate) fn rigid_route_cached(
     (choose_alternatives(alternatives, &chosen), warnings)
 }
 
+/// [`rigid_route_cached`] with the pose chosen as the fusion takes it: where `weigh_poses`
+/// and the registration's choice on a target is the outlier among `others(i)` (the labels the
+/// routes that fail independently of it give shape `i`; [`rigid_choice_is_outlier`]), every
+/// other source and pose is carried there and [`choose_rigid_alternative`] takes one.
+/// `areas`: per shape, its vertex areas. The other alternatives are carried only for those
+/// targets: elsewhere they could not be taken, and carrying each costs an affine fit.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn rigid_route_weighed<'a>(
+    meshes: &[TriMesh],
+    annotations: &[Option<Vec<i32>>],
+    affine: bool,
+    targets: &[usize],
+    cache: &RigidCache,
+    weigh_poses: bool,
+    others: impl Fn(usize) -> Vec<&'a [i32]>,
+    areas: &[&[f64]],
+) -> (RouteLabels, Vec<String>) {
+    let (mut alternatives, warnings) =
+        rigid_alternatives_cached(meshes, annotations, affine, targets, cache, false);
+    let outliers: Vec<usize> = targets
+        .iter()
+        .copied()
+        .filter(|&i| {
+            weigh_poses
+                && alternatives[i]
+                    .first()
+                    .is_some_and(|a| rigid_choice_is_outlier(&a.labels, &others(i), areas[i]))
+        })
+        .collect();
+    if !outliers.is_empty() {
+        let (more, _) =
+            rigid_alternatives_cached(meshes, annotations, affine, &outliers, cache, true);
+        for (i, m) in more.into_iter().enumerate() {
+            if !m.is_empty() {
+                alternatives[i] = m;
+            }
+        }
+    }
+    let chosen: Vec<usize> = alternatives
+        .iter()
+        .enumerate()
+        .map(|(i, alts)| {
+            if alts.len() < 2 {
+                return 0;
+            }
+            let alts: Vec<&[i32]> = alts.iter().map(|a| a.labels.as_slice()).collect();
+            choose_rigid_alternative(&alts, &others(i), areas[i])
+        })
+        .collect();
+    (choose_alternatives(alternatives, &chosen), warnings)
+}
+
 /// One way the rigid route can carry the labels onto a shape: a source and one locally
 /// optimal pose of the shape on it ([`Registration::candidates`]).
 #[derive(Debug, Clone, PartialEq)]
@@ -366,10 +418,7 @@ pub(crate) fn rigid_alternatives_cached(
 
 /// The rigid route's labels on every shape from its alternatives: on shape `i` the
 /// alternative `chosen[i]` (the first where `chosen[i]` is out of range).
-pub(crate) fn choose_alternatives(
-    alternatives: Vec<Vec<RigidAlternative>>,
-    chosen: &[usize],
-) -> RouteLabels {
+fn choose_alternatives(alternatives: Vec<Vec<RigidAlternative>>, chosen: &[usize]) -> RouteLabels {
     let mut out = RouteLabels::empty(alternatives.len());
     for (i, alts) in alternatives.into_iter().enumerate() {
         let k = chosen
@@ -444,11 +493,7 @@ pub fn choose_rigid_alternative(
     others: &[&[i32]],
     areas: &[f64],
 ) -> usize {
-    let others: Vec<&[i32]> = others
-        .iter()
-        .copied()
-        .filter(|o| o.len() == areas.len() && o.iter().any(|&l| l >= 0))
-        .collect();
+    let others = voting(others, areas);
     if others.len() < 2 || alternatives.len() < 2 {
         return 0;
     }
@@ -483,11 +528,7 @@ pub fn choose_rigid_alternative(
 /// enough to run before the other poses are carried at all. False with fewer than two other
 /// routes.
 pub fn rigid_choice_is_outlier(own: &[i32], others: &[&[i32]], areas: &[f64]) -> bool {
-    let others: Vec<&[i32]> = others
-        .iter()
-        .copied()
-        .filter(|o| o.len() == areas.len() && o.iter().any(|&l| l >= 0))
-        .collect();
+    let others = voting(others, areas);
     if others.len() < 2 || own.len() != areas.len() {
         return false;
     }
@@ -498,4 +539,14 @@ pub fn rigid_choice_is_outlier(own: &[i32], others: &[&[i32]], areas: &[f64]) ->
         }
     }
     others.iter().all(|o| cohen_kappa(own, o, areas) < among)
+}
+
+/// The routes of `others` that say something on the shape (each as long as `areas`, some
+/// vertex labelled).
+fn voting<'a>(others: &[&'a [i32]], areas: &[f64]) -> Vec<&'a [i32]> {
+    others
+        .iter()
+        .copied()
+        .filter(|o| o.len() == areas.len() && o.iter().any(|&l| l >= 0))
+        .collect()
 }
