@@ -41,7 +41,7 @@ pub use families::{
     parse_family_weights,
 };
 pub use heat_kernel_signature::heat_kernel_signature;
-pub use mean_curvature::mean_curvature;
+pub use mean_curvature::{mean_curvature, mean_curvature_resolution};
 pub use multiscale_mean_curvature::multiscale_mean_curvature;
 pub use scale_grid::{ScaleGrid, SpectralBand, scale_grid};
 pub(crate) use sdf::inward_wound;

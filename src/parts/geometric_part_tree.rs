@@ -22,12 +22,15 @@
 //! diameter function, [`crate::features::shape_diameter`] with one smoothing round,
 //! scale-normalised per shape); `c(x, y)` = the (upper) median over shapes of the concave
 //! share of their common boundary (the length of boundary edges whose endpoints' mean
-//! curvature sums to < 0, [`crate::features::mean_curvature`], over the boundary's length;
+//! curvature sums to < 0 by more than the curvature's resolution,
+//! [`crate::features::mean_curvature`], [`crate::features::mean_curvature_resolution`]: a flat
+//! stretch is not concave whichever way rounding tips its sign; over the boundary's length;
 //! 0 for linked regions that do not touch). Complete linkage on thickness keeps a group's
 //! thickness spread small. Each merge records the similarity `exp(−cost)` (1 = alike).
 
 use super::adaptive_cosegment::{PartMerge, PartTree};
 use super::part_cues::PartCues;
+use crate::features::mean_curvature_resolution;
 use crate::graph::{Cosegmentation, GraphError};
 use crate::mesh::{TriMesh, for_each_label_boundary};
 use rayon::prelude::*;
@@ -374,11 +377,18 @@ fn boundaries(
         .enumerate()
         .map(|(i, (mesh, cues))| {
             let h = &cues.mean_curvature;
+            // Concave only beyond what the coordinates resolve: on a flat stretch the sign of
+            // `H` is rounding ([`mean_curvature_resolution`]).
+            let flat = mean_curvature_resolution(mesh);
             let labels = coseg.labels(i);
             let mut len = vec![vec![(0.0, 0.0); l]; l];
             for_each_label_boundary(mesh, &labels, |u, v, e| {
                 let (x, y) = (labels[u] as usize, labels[v] as usize);
-                let c = if h[u] + h[v] < 0.0 { e } else { 0.0 };
+                let c = if h[u] + h[v] < -(flat[u] + flat[v]) {
+                    e
+                } else {
+                    0.0
+                };
                 for (a, b) in [(x, y), (y, x)] {
                     len[a][b].0 += c;
                     len[a][b].1 += e;

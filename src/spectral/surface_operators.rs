@@ -215,6 +215,23 @@ impl SurfaceOperators {
         }
         lx
     }
+
+    /// `Σ_j |w_ij|` for every vertex `i` (length `d`): the off-diagonal weights of
+    /// [`Self::laplacian`] in absolute value, summed per row (half-cotangents of obtuse corners
+    /// are negative). How far `(L X)_i` can move when every coordinate of `X` moves by at most
+    /// `ε`: `2 ε Σ_j |w_ij|` per component. `mesh` must be the mesh the operators were built
+    /// from.
+    pub fn absolute_weight_sums(&self, mesh: &TriMesh) -> Vec<f64> {
+        let mut s = vec![0.0f64; self.vertex_count()];
+        for (idx, w) in self.faces(mesh).iter().zip(&self.half_cotangents) {
+            for (k, &wk) in w.iter().enumerate() {
+                let (a, b) = (idx[(k + 1) % 3] as usize, idx[(k + 2) % 3] as usize);
+                s[a] += wk.abs();
+                s[b] += wk.abs();
+            }
+        }
+        s
+    }
 }
 
 /// The cotangent Laplacian alone (see [`super::cotan_laplacian`]).
