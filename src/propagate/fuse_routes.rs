@@ -164,6 +164,7 @@ pub fn fuse_routes_with(
     };
     // First pass: every shape's voting routes, label count and κ estimates.
     let mut shapes: Vec<Option<ShapeVotes>> = vec![None; n];
+    let mut matrices: Vec<Vec<Vec<f64>>> = vec![Vec::new(); n];
     for (i, &a) in areas.iter().enumerate() {
         let voting: Vec<usize> = (0..nr).filter(|&r| routes[r].votes_on(i)).collect();
         if voting.is_empty() {
@@ -175,12 +176,28 @@ pub fn fuse_routes_with(
             .collect();
         values.sort_unstable();
         values.dedup();
-        let kappas = route_kappas(&pair_kappa(routes, &voting, i, a));
+        let matrix = pair_kappa(routes, &voting, i, a);
+        let kappas = route_kappas(&matrix);
         shapes[i] = Some((voting, values.len(), kappas));
+        matrices[i] = matrix;
     }
     if let Some(h) = held_out {
         calibrate(&mut shapes, h, nr);
     }
+    let pair_in = |voting: &[usize]| {
+        shared.and_then(|(x, y)| {
+            Some((
+                voting.iter().position(|&r| r == x)?,
+                voting.iter().position(|&r| r == y)?,
+            ))
+        })
+    };
+    // One source, a pair that may fail together: the shapes where one of the pair collapsed
+    // with its partner, re-weighted from the collection's levels (`pair_collapse`).
+    let collapses: Vec<Option<Vec<f64>>> = match held_out {
+        None => collapse_weights(routes, areas, &shapes, &matrices, pair_in),
+        Some(_) => vec![None; n],
+    };
     for (i, &a) in areas.iter().enumerate() {
         let Some((voting, labels, kappas)) = shapes[i].take() else {
             continue;
@@ -191,14 +208,12 @@ pub fn fuse_routes_with(
             true => vec![1.0; m],
             false => kappas.iter().map(|&k| log_odds(k, labels)).collect(),
         };
-        let pair = shared.and_then(|(x, y)| {
-            Some((
-                voting.iter().position(|&r| r == x)?,
-                voting.iter().position(|&r| r == y)?,
-            ))
-        });
+        let pair = pair_in(&voting);
+        if let Some(w) = &collapses[i] {
+            trust = w.clone();
+        }
         let vote = match pair {
-            Some(pair) if m == 3 && held_out.is_none() => {
+            Some(pair) if m == 3 && held_out.is_none() && collapses[i].is_none() => {
                 let ranks: Vec<Vec<f64>> = voting
                     .iter()
                     .map(|&r| area_ranks(&routes[r].confidence[i], a))
@@ -513,6 +528,89 @@ fn shared_failure_vote(
     classes: usize,
     pair: (usize, usize),
 ) -> Option<SharedFailureVote> {
+    let fit = shared_failure_fit(labels, areas, classes, pair)?;
+    let (p, gamma, accuracy) = (fit.p, fit.gamma, fit.accuracy);
+    let m = labels.len();
+    let d = areas.len();
+    let l = classes.max(2) as f64;
+    let c = 1.0 / (l - 1.0);
+    let mut out = vec![-1i32; d];
+    let mut conf = vec![0.0; d];
+    let mut candidates: Vec<i32> = Vec::with_capacity(m);
+    for v in 0..d {
+        candidates.clear();
+        candidates.extend((0..m).map(|x| labels[x][v]).filter(|&x| x >= 0));
+        candidates.sort_unstable();
+        candidates.dedup();
+        let (a, b) = (labels[pair.0][v], labels[pair.1][v]);
+        let (mut best, mut second, mut total) = (None::<(i32, f64)>, 0.0, 0.0);
+        // Ascending labels and a strict comparison: ties go to the smallest label.
+        for &truth in &candidates {
+            let mut indep = 1.0;
+            let mut shared = if a >= 0 && a == b && a != truth {
+                c
+            } else {
+                0.0
+            };
+            for x in 0..m {
+                let lab = labels[x][v];
+                if lab < 0 {
+                    continue;
+                }
+                let f = if lab == truth { p[x] } else { (1.0 - p[x]) * c };
+                let f = f.powf((1.0 + ranks[x][v]) / 2.0);
+                indep *= f;
+                if x != pair.0 && x != pair.1 {
+                    shared *= f;
+                }
+            }
+            let post = (1.0 - gamma) * indep + gamma * shared;
+            total += post;
+            match best {
+                Some((_, q)) if q >= post => second = f64::max(second, post),
+                _ => {
+                    if let Some((_, q)) = best {
+                        second = f64::max(second, q);
+                    }
+                    best = Some((truth, post));
+                }
+            }
+        }
+        if let Some((k, q)) = best {
+            out[v] = k;
+            conf[v] = if total > 0.0 {
+                ((q - second) / total).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+        }
+    }
+    Some(SharedFailureVote {
+        labels: out,
+        confidence: conf,
+        accuracy,
+    })
+}
+
+/// The parameters [`shared_failure_vote`] reads off one shape's agreement patterns.
+struct SharedFailureFit {
+    /// Per route: its accuracy outside the shared failures.
+    p: [f64; 3],
+    /// The share of the surface on which the pair gives the same wrong label.
+    gamma: f64,
+    /// Per route: its accuracy over the surface (a pair route is wrong on the shared share).
+    accuracy: Vec<f64>,
+}
+
+/// The shared-failure model of [`shared_failure_vote`] fitted to one shape by the method of
+/// moments; `None` without three routes, without a vertex where all three agree, or when
+/// the fit puts a route below chance.
+fn shared_failure_fit(
+    labels: &[&[i32]],
+    areas: &[f64],
+    classes: usize,
+    pair: (usize, usize),
+) -> Option<SharedFailureFit> {
     let m = labels.len();
     let d = areas.len();
     if m != 3 {
@@ -574,60 +672,119 @@ fn shared_failure_vote(
     if accuracy.iter().any(|&a| a < 1.0 / l) {
         return None;
     }
-    let mut out = vec![-1i32; d];
-    let mut conf = vec![0.0; d];
-    let mut candidates: Vec<i32> = Vec::with_capacity(m);
-    for v in 0..d {
-        candidates.clear();
-        candidates.extend((0..m).map(|x| labels[x][v]).filter(|&x| x >= 0));
-        candidates.sort_unstable();
-        candidates.dedup();
-        let (a, b) = (labels[pair.0][v], labels[pair.1][v]);
-        let (mut best, mut second, mut total) = (None::<(i32, f64)>, 0.0, 0.0);
-        // Ascending labels and a strict comparison: ties go to the smallest label.
-        for &truth in &candidates {
-            let mut indep = 1.0;
-            let mut shared = if a >= 0 && a == b && a != truth {
-                c
-            } else {
-                0.0
-            };
-            for x in 0..m {
-                let lab = labels[x][v];
-                if lab < 0 {
-                    continue;
-                }
-                let f = if lab == truth { p[x] } else { (1.0 - p[x]) * c };
-                let f = f.powf((1.0 + ranks[x][v]) / 2.0);
-                indep *= f;
-                if x != pair.0 && x != pair.1 {
-                    shared *= f;
-                }
-            }
-            let post = (1.0 - gamma) * indep + gamma * shared;
-            total += post;
-            match best {
-                Some((_, q)) if q >= post => second = f64::max(second, post),
-                _ => {
-                    if let Some((_, q)) = best {
-                        second = f64::max(second, q);
-                    }
-                    best = Some((truth, post));
-                }
-            }
+    Some(SharedFailureFit { p, gamma, accuracy })
+}
+
+/// Which member of the shared `pair` (voting positions) collapsed with its partner on a shape
+/// with the pairwise κ `kappa` and the independent route `third`: `(collapsed, kept, third)`,
+/// or `None`.
+///
+/// Under the one-coin model a route cannot agree with both others more than they agree with
+/// each other allows (`κ_xy κ_xz ≤ κ_yz`: its accuracy read off the triangle would exceed 1).
+/// Where a pair member `x` does, while its partner `y` agrees with the independent route less
+/// than `x` does, the pair's agreement is not two opinions: `y` has failed *with* `x` (an
+/// intrinsic co-segmentation that swapped arms and legs on a generated humanoid, agreeing
+/// with the band affinity on 30–36 % of the body and with the rigid route at chance), and
+/// what it shares with `x` is their common error. The test needs no threshold: the bound is
+/// the model's own.
+fn pair_collapse(
+    kappa: &[Vec<f64>],
+    pair: (usize, usize),
+    third: usize,
+) -> Option<(usize, usize, usize)> {
+    let z = third;
+    [(pair.0, pair.1), (pair.1, pair.0)]
+        .into_iter()
+        .find(|&(x, y)| {
+            kappa[x][y] > 0.0
+                && kappa[x][z] > 0.0
+                && kappa[x][y] * kappa[x][z] > kappa[y][z].max(0.0)
+                && kappa[y][z] < kappa[x][z]
+        })
+        .map(|(x, y)| (y, x, z))
+}
+
+/// The median of `values` (the mean of the middle two for an even count); `None` when empty.
+fn median(mut values: Vec<f64>) -> Option<f64> {
+    if values.is_empty() {
+        return None;
+    }
+    values.sort_by(f64::total_cmp);
+    let k = values.len();
+    Some(match k % 2 {
+        1 => values[k / 2],
+        _ => (values[k / 2 - 1] + values[k / 2]) / 2.0,
+    })
+}
+
+/// Per shape, the vote weights (voting positions) where a member of the shared pair collapsed
+/// with its partner ([`pair_collapse`]); `None` on the other shapes, which keep the
+/// shared-failure vote.
+///
+/// The collapsed member gets no vote. The other two, its partner `x` and the independent
+/// route `z`, are two routes whose accuracies one shape cannot separate (their agreement
+/// `κ_xz = κ_x κ_z` gives only the product); the evidence that separates them comes from
+/// outside the shape: each route's level over the collection, the median of its accuracy
+/// above chance under the shared-failure fit on the shapes where no member collapsed (`ℓ`).
+/// The product comes from this shape and the ratio from the collection: `κ_x = √(κ_xz ℓ_x /
+/// ℓ_z)`, `κ_z = √(κ_xz ℓ_z / ℓ_x)`, each weighted by its log-odds. Shapes where both members
+/// fail together, or the independent route collapsed (it agrees with neither), are not
+/// caught (no member agrees with it above the other). Without a shape to read the levels on,
+/// nothing changes.
+fn collapse_weights(
+    routes: &[&RouteLabels],
+    areas: &[&[f64]],
+    shapes: &[Option<ShapeVotes>],
+    matrices: &[Vec<Vec<f64>>],
+    pair_in: impl Fn(&[usize]) -> Option<(usize, usize)>,
+) -> Vec<Option<Vec<f64>>> {
+    let n = shapes.len();
+    let mut out = vec![None; n];
+    let mut collapsed = vec![None; n];
+    let mut levels: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
+    for (i, s) in shapes.iter().enumerate() {
+        let Some((voting, classes, _)) = s else {
+            continue;
+        };
+        let Some(pair) = pair_in(voting).filter(|_| voting.len() == 3) else {
+            continue;
+        };
+        let third = 3 - pair.0 - pair.1;
+        if let Some(c) = pair_collapse(&matrices[i], pair, third) {
+            collapsed[i] = Some(c);
+            continue;
         }
-        if let Some((k, q)) = best {
-            out[v] = k;
-            conf[v] = if total > 0.0 {
-                ((q - second) / total).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
+        let lab: Vec<&[i32]> = voting
+            .iter()
+            .map(|&r| routes[r].labels[i].as_slice())
+            .collect();
+        if let Some(fit) = shared_failure_fit(&lab, areas[i], *classes, pair) {
+            let l = (*classes).max(2) as f64;
+            for (x, &r) in voting.iter().enumerate() {
+                let k = ((fit.accuracy[x] - 1.0 / l) / (1.0 - 1.0 / l)).clamp(0.0, MAX_KAPPA);
+                levels.entry(r).or_default().push(k);
+            }
         }
     }
-    Some(SharedFailureVote {
-        labels: out,
-        confidence: conf,
-        accuracy,
-    })
+    let level: BTreeMap<usize, f64> = levels
+        .into_iter()
+        .filter_map(|(r, v)| Some((r, median(v)?)))
+        .collect();
+    for (i, c) in collapsed.into_iter().enumerate() {
+        let (Some((_, x, z)), Some((voting, classes, _))) = (c, &shapes[i]) else {
+            continue;
+        };
+        let (Some(&lx), Some(&lz)) = (level.get(&voting[x]), level.get(&voting[z])) else {
+            continue;
+        };
+        if !(lx > 0.0 && lz > 0.0) {
+            continue;
+        }
+        let kxz = matrices[i][x][z];
+        let mut w = vec![0.0; voting.len()];
+        w[x] = log_odds((kxz * lx / lz).sqrt(), *classes);
+        w[z] = log_odds((kxz * lz / lx).sqrt(), *classes);
+        out[i] = Some(w);
+    }
+    out
 }
