@@ -702,7 +702,7 @@ fn parts_collapsed_with_the_affinity(d: usize) -> (Vec<Vec<i32>>, [RouteLabels; 
         }
     };
     let swap = |l: i32| [1, 0, 3, 2][l as usize];
-    let mut truth = vec![Vec::new(); n];
+    let mut truth = vec![Vec::new()];
     let mut routes = [
         RouteLabels::empty(n),
         RouteLabels::empty(n),
@@ -740,7 +740,7 @@ fn parts_collapsed_with_the_affinity(d: usize) -> (Vec<Vec<i32>>, [RouteLabels; 
             route.confidence[i] = vec![0.5; d];
             route.labels[i] = labels;
         }
-        truth[i] = t;
+        truth.push(t);
     }
     let mut areas = vec![vec![1.0; d]; n];
     areas[0] = vec![1.0; 4];
@@ -758,10 +758,10 @@ fn a_parts_route_collapsed_with_the_affinity_does_not_outvote_the_rigid_route() 
     let refs: Vec<&RouteLabels> = routes.iter().collect();
     let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
     let fused = fuse_routes_with(&refs, &area_refs, None, Some((0, 1)));
-    for i in 1..7 {
-        let acc = accuracy(&fused.labels[i], &truth[i]);
-        let rigid = accuracy(&routes[2].labels[i], &truth[i]);
-        let parts = accuracy(&routes[1].labels[i], &truth[i]);
+    for (i, t) in truth.iter().enumerate().skip(1) {
+        let acc = accuracy(&fused.labels[i], t);
+        let rigid = accuracy(&routes[2].labels[i], t);
+        let parts = accuracy(&routes[1].labels[i], t);
         // Where the parts hold the fusion is as good as the weaker of parts and rigid; where
         // they collapsed, as good as the rigid route (before: the affinity's 45 %).
         let floor = if i >= 4 { rigid } else { rigid.min(parts) };
