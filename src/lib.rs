@@ -51,6 +51,7 @@ pub mod render;
 pub mod shape_task;
 pub mod spectral;
 pub mod stable;
+pub mod stage_timer;
 pub mod studio;
 mod vertex_sets;
 

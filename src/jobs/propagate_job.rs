@@ -146,8 +146,11 @@ pub fn run_propagate(
     let summary = PropagationSummary::of(&result, &options.graph, &options.propagate);
     let mut written = Vec::new();
     if let Some(dir) = &job.output {
+        let timer = crate::stage_timer::stage("writing labels");
         written = write_propagation(dir, &result, &summary)?;
+        drop(timer);
         if job.pictures {
+            let _t = crate::stage_timer::stage("pictures");
             let p = &result.propagation;
             let pictures: Vec<RenderShape> = (0..result.graph.node_count())
                 .map(|i| RenderShape {

@@ -173,7 +173,10 @@ pub(crate) fn choose_features(
     let mut best: Option<Candidate> = None;
     let mut aligned_scores = Vec::new();
     let mut frame = None;
-    match align_collection(meshes, &options.align) {
+    let timer = crate::stage_timer::stage("parts: align collection");
+    let aligned = align_collection(meshes, &options.align);
+    drop(timer);
+    match aligned {
         Err(e) => warnings.push(format!(
             "the collection could not be aligned ({e}): the intrinsic family alone is used"
         )),
@@ -215,6 +218,9 @@ pub(crate) fn choose_features(
                 };
                 let ext = tables.first().map_or(0, |t| t.features);
                 let weights = families.feature_weights(spectral, [ext, 0, 0]);
+                let _t = crate::stage_timer::stage(format!(
+                    "parts: aligned candidate (reverse {reverse})"
+                ));
                 let mut g = ShapeGraph::build(both, graph)?;
                 g.set_feature_weights(weights.clone())?;
                 let score = start_score(&cosegment(&g, &probe)?);
@@ -225,8 +231,10 @@ pub(crate) fn choose_features(
             }
         }
     }
+    let timer = crate::stage_timer::stage("parts: intrinsic candidate");
     let intrinsic = ShapeGraph::build(nodes, graph)?;
     let intrinsic_score = start_score(&cosegment(&intrinsic, &probe)?);
+    drop(timer);
     let aligned_score = best.as_ref().map(|b| b.0);
     let case = match frame {
         Some(FrameCase::AlreadyAligned) => "the files' frames agree",

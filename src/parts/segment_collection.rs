@@ -641,6 +641,7 @@ pub fn segment_collection(
     };
     let (graph, chosen_options, features) = match choose {
         Some(c) => {
+            let _t = crate::stage_timer::stage("parts: choose features");
             let chosen = choose_features(
                 nodes,
                 meshes,
@@ -698,6 +699,7 @@ pub fn segment_collection(
         _ => None,
     };
     let t = Instant::now();
+    let timer = crate::stage_timer::stage("parts: heat smoothers");
     let smoothers = match refine {
         Some(r) if smoothing => Some(
             meshes
@@ -714,6 +716,7 @@ pub fn segment_collection(
         _ => None,
     };
     times.smoothers = t.elapsed();
+    drop(timer);
     let cues = match geometry {
         Some(_) => {
             let t = Instant::now();
@@ -723,6 +726,7 @@ pub fn segment_collection(
                 ));
             }
             let name = |i: usize| graph.node(i).name.clone();
+            let _t = crate::stage_timer::stage("parts: cues");
             let cues = collection_cues(meshes, name, options.cue_cache.as_deref(), &mut warnings)?;
             times.part_cues = Some(t.elapsed());
             Some(cues)
@@ -734,6 +738,7 @@ pub fn segment_collection(
     let mut start_scores = Vec::with_capacity(options.starts);
     for start in 0..options.starts {
         let t = Instant::now();
+        let timer = crate::stage_timer::stage("parts: cosegment");
         let (mut segmentation, mut adaptive) = match (&options.parts, geometry) {
             (_, Some((leaves, _, _))) => {
                 let mut o = options.cosegment;
@@ -759,8 +764,10 @@ pub fn segment_collection(
             }
         };
         times.cosegment += t.elapsed();
+        drop(timer);
         if let Some(refine) = refine {
             let t = Instant::now();
+            let _t = crate::stage_timer::stage("parts: refine");
             // Equal-area leaves have no sizes from the data to keep.
             let sizes = match geometry {
                 Some(_) => RefineSizes::Free,
@@ -781,6 +788,7 @@ pub fn segment_collection(
         // leaves', move onto the creases between parts.
         if let Some((_, parts, band)) = geometry {
             let t = Instant::now();
+            let _t = crate::stage_timer::stage("parts: geometric tree and snapping");
             let regions = segmentation.tuples.len();
             let split = split_disconnected_leaves(meshes, &segmentation)?;
             let siblings = split.siblings();

@@ -117,7 +117,9 @@ pub fn propagate_collection(
         .cache_dir
         .clone()
         .unwrap_or_else(|| std::env::temp_dir().join("coseg-cache"));
+    let timer = crate::stage_timer::stage("per-shape stage (load_collection)");
     let loaded = load_collection(folder, &options.pipeline, &cache, |_, _, _| {})?;
+    drop(timer);
     let mut warnings = loaded.warnings.clone();
     let stems: Vec<String> = loaded.nodes.iter().map(|n| n.name.clone()).collect();
     let (matched, w) = match_label_files(labels, &stems)?;
@@ -172,6 +174,7 @@ pub fn propagate_collection(
         Some(ms) => {
             ms.validate()
                 .map_err(|e| PropagateError::BadOption(e.to_string()))?;
+            let _t = crate::stage_timer::stage("map step");
             let (reports, w) = map_step_collection(
                 &loaded.meshes,
                 &solved.graph,
@@ -372,10 +375,13 @@ pub fn propagate_loaded(
             options.cache_dir.clone(),
         )
     });
+    let timer = crate::stage_timer::stage("shape graph");
     let mut graph = ShapeGraph::build(nodes, &options.graph)?;
+    drop(timer);
     // The families' shares of the affinity (`--family-weights`), as `coseg segment` uses them.
     graph.set_feature_weights(options.pipeline.feature_weights(features))?;
     let time = options.propagate.smoothing_time;
+    let timer = crate::stage_timer::stage("heat smoothers");
     let smoothers: Vec<HeatSmoother> = if time > 0.0 {
         match meshes
             .par_iter()
@@ -391,8 +397,11 @@ pub fn propagate_loaded(
     } else {
         Vec::new()
     };
+    drop(timer);
     let smooth = (!smoothers.is_empty()).then_some(smoothers.as_slice());
+    let timer = crate::stage_timer::stage("affinity route (propagate_labels)");
     let mut propagation = propagate_labels(&graph, smooth, annotations, &options.propagate)?;
+    drop(timer);
     let fusion = fuse_propagation(
         &graph,
         meshes,

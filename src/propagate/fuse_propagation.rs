@@ -223,6 +223,7 @@ pub fn fuse_propagation(
     let mut parts_intrinsic = false;
     if let (true, Some(parts)) = (options.parts, parts) {
         let count = propagation.parts.len();
+        let _t = crate::stage_timer::stage("parts route (co-segmentation)");
         match parts.parts(count, meshes) {
             Ok(_) => {
                 parts_intrinsic = parts.intrinsic_only(count).unwrap_or(true);
@@ -243,6 +244,7 @@ pub fn fuse_propagation(
     let rigid_poses = segmentation.is_some() && !parts_intrinsic;
     if options.rigid {
         let targets: Vec<usize> = (0..n).filter(|&i| annotations[i].is_none()).collect();
+        let _t = crate::stage_timer::stage("rigid route");
         let (rigid, warnings) = rigid_route_weighed(
             meshes,
             annotations,
@@ -274,7 +276,10 @@ pub fn fuse_propagation(
         segmentation,
         affine: options.affine,
     };
+    let timer = crate::stage_timer::stage("held-out routes on the sources");
     report.held_out_runs = held_out_routes_cached(&held_out, &propagation.rigid, rigid_poses)?;
+    drop(timer);
+    let _t = crate::stage_timer::stage("fusion and snapping");
     report.held_out = report.held_out_runs.as_ref().map(|h| h.accuracy.clone());
     let refs: Vec<&RouteLabels> = report.routes.iter().map(|(_, r)| r).collect();
     // The band affinity and the parts route fail together where both read the intrinsic

@@ -131,6 +131,7 @@ pub(crate) fn held_out_routes_cached(
         let mut residual = Vec::with_capacity(routes.len());
         let mut skipped = false;
         for route in routes {
+            let _t = crate::stage_timer::stage(format!("held-out {route:?} on source {s}"));
             let (l, c, e): (Vec<i32>, Vec<f64>, f64) = match route {
                 Route::Affinity => match propagate_labels(graph, smoothers, &ann, propagate) {
                     Ok(p) => (p.labels[s].clone(), p.confidence[s].clone(), f64::NAN),
