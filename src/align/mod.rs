@@ -35,6 +35,9 @@ pub use nearest_point_labels::{nearest_point_labels, nearest_point_vertex_labels
 pub use register_pair::{Candidate, RegisterOptions, Registration, register_pair};
 pub use similarity::Similarity;
 
+pub(crate) use nearest_point_labels::nearest_point_vertex_labels_in;
+pub(crate) use register_pair::register_onto;
+pub(crate) use surface_samples::Prepared;
 use thiserror::Error;
 
 /// Errors of the alignment stage.

@@ -64,6 +64,24 @@ pub fn nearest_point_vertex_labels(
     target: &TriMesh,
     transform: &Similarity,
 ) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
+    nearest_point_vertex_labels_in(
+        &SurfaceIndex::new(source),
+        source,
+        source_vertex_labels,
+        target,
+        transform,
+    )
+}
+
+/// [`nearest_point_vertex_labels`] with the source's index given (`SurfaceIndex::new(source)`),
+/// for many targets read from one source: the same result.
+pub(crate) fn nearest_point_vertex_labels_in(
+    index: &SurfaceIndex,
+    source: &TriMesh,
+    source_vertex_labels: &[i32],
+    target: &TriMesh,
+    transform: &Similarity,
+) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
     if source_vertex_labels.len() != source.vertex_count() {
         return Err(AlignError::LabelCount {
             expected: source.vertex_count(),
@@ -71,7 +89,6 @@ pub fn nearest_point_vertex_labels(
             kind: "vertex",
         });
     }
-    let index = SurfaceIndex::new(source);
     let faces = source.faces();
     Ok(target
         .positions()

@@ -140,6 +140,19 @@ pub fn register_pair(
     Ok(register_prepared(&s, &t, options))
 }
 
+/// [`register_pair`] with the source already prepared (`Prepared::new(source, options.samples,
+/// options.seed)`), for many targets registered onto one source: the same result, the
+/// source's samples and indices made once.
+pub(crate) fn register_onto(
+    source: &Prepared,
+    target: &TriMesh,
+    options: &RegisterOptions,
+) -> Result<Registration, AlignError> {
+    options.check()?;
+    let t = Prepared::new(target, options.samples, options.seed)?;
+    Ok(register_prepared(source, &t, options))
+}
+
 /// [`register_pair`] on shapes already prepared (their samples and indices reused).
 pub(crate) fn register_prepared(
     s: &Prepared,

@@ -7,14 +7,17 @@ use petgraph::graph::{NodeIndex, UnGraph};
 use petgraph::visit::EdgeRef;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeSet;
+use std::sync::Arc;
 
 /// A shape of the collection: everything the co-segmentation needs, from the per-shape cache.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ShapeNode {
     /// Display name (the file stem for a folder).
     pub name: String,
-    /// `d × N` band labels.
-    pub bands: BandTable,
+    /// `d × N` band labels, shared: the graphs a collection stage builds over the same shapes
+    /// (the propagation's, the parts route's candidates) hold one table per shape, not a copy
+    /// each.
+    pub bands: Arc<BandTable>,
     /// Unit-normalised vertex areas (length `d`, sum 1).
     pub areas: Vec<f64>,
 }
@@ -24,10 +27,11 @@ impl ShapeNode {
     /// by their sum).
     pub fn new(
         name: impl Into<String>,
-        bands: BandTable,
+        bands: impl Into<Arc<BandTable>>,
         areas: &[f64],
     ) -> Result<Self, GraphError> {
         let name = name.into();
+        let bands = bands.into();
         if areas.len() != bands.vertices {
             return Err(GraphError::Incompatible {
                 name,
@@ -439,29 +443,50 @@ fn check_nodes(nodes: &[ShapeNode]) -> Result<(), GraphError> {
 fn nearest_pairs(
     n: usize,
     k: usize,
-    dist: &impl Fn(usize, usize) -> f64,
+    dist: &(impl Fn(usize, usize) -> f64 + Sync),
 ) -> BTreeSet<(usize, usize)> {
+    use rayon::prelude::*;
+    // Each shape's neighbours are found independently (in parallel) and merged in index
+    // order: the set is the same whatever the thread count. A partial selection keeps the
+    // `k` smallest `(distance, index)` without sorting all `n`.
+    let nearest: Vec<Vec<usize>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            let mut others: Vec<(f64, usize)> = (0..n)
+                .filter(|&j| j != i)
+                .map(|j| (dist(i, j), j))
+                .collect();
+            let order =
+                |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+            if others.len() > k {
+                others.select_nth_unstable_by(k, order);
+                others.truncate(k);
+            }
+            others.sort_by(order);
+            others.into_iter().map(|(_, j)| j).collect()
+        })
+        .collect();
     let mut set = BTreeSet::new();
-    for i in 0..n {
-        let mut others: Vec<(f64, usize)> = (0..n)
-            .filter(|&j| j != i)
-            .map(|j| (dist(i, j), j))
-            .collect();
-        others.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-        for &(_, j) in others.iter().take(k) {
+    for (i, js) in nearest.into_iter().enumerate() {
+        for j in js {
             set.insert((i.min(j), i.max(j)));
         }
     }
     set
 }
 
+/// Shapes per parallel task of Prim's distance update: one distance is a few hundred flops, so
+/// smaller tasks would cost more in scheduling than they save.
+const PRIM_CHUNK: usize = 256;
+
 /// Adds to `set` the edges of the minimum spanning tree of the complete `dist` graph on `n`
 /// shapes (Prim from node 0, ties by index).
 fn add_spanning_tree(
     n: usize,
-    dist: &impl Fn(usize, usize) -> f64,
+    dist: &(impl Fn(usize, usize) -> f64 + Sync),
     set: &mut BTreeSet<(usize, usize)>,
 ) {
+    use rayon::prelude::*;
     // Prim's minimum spanning tree on the complete distance graph.
     let mut in_tree = vec![false; n];
     let mut best = vec![(f64::INFINITY, usize::MAX); n];
@@ -479,13 +504,18 @@ fn add_spanning_tree(
         in_tree[pick] = true;
         let p = best[pick].1;
         set.insert((p.min(pick), p.max(pick)));
-        for j in 0..n {
-            if !in_tree[j] {
-                let d = dist(pick, j);
-                if d.total_cmp(&best[j].0).is_lt() {
-                    best[j] = (d, pick);
+        // Each entry is updated from its own distance alone: the same in parallel.
+        best.par_iter_mut()
+            .zip(in_tree.par_iter())
+            .enumerate()
+            .with_min_len(PRIM_CHUNK)
+            .for_each(|(j, (b, &done))| {
+                if !done {
+                    let d = dist(pick, j);
+                    if d.total_cmp(&b.0).is_lt() {
+                        *b = (d, pick);
+                    }
                 }
-            }
-        }
+            });
     }
 }

@@ -207,7 +207,7 @@ pub(crate) fn choose_features(
                     .iter()
                     .zip(&tables)
                     .map(|(n, t)| ShapeNode {
-                        bands: concat_tables(&n.bands, t),
+                        bands: concat_tables(&n.bands, t).into(),
                         ..n.clone()
                     })
                     .collect();

@@ -609,6 +609,19 @@ pub fn segment_collection(
     meshes: &[TriMesh],
     options: &SegmentCollectionOptions,
 ) -> Result<SegmentedCollection, GraphError> {
+    segment_collection_sharing(nodes, meshes, options, None)
+}
+
+/// [`segment_collection`] reading the refinement's heat smoothers from `shared` (one per mesh,
+/// as [`HeatSmoother::new`] makes them) where they have the refinement's smoothing time: the
+/// same result without factorising and holding a second smoother per shape. Smoothers that do
+/// not fit (another time, another vertex count) are ignored and made afresh.
+pub(crate) fn segment_collection_sharing(
+    nodes: Vec<ShapeNode>,
+    meshes: &[TriMesh],
+    options: &SegmentCollectionOptions,
+    shared: Option<&[HeatSmoother]>,
+) -> Result<SegmentedCollection, GraphError> {
     let smoothing = options
         .refine
         .as_ref()
@@ -700,8 +713,18 @@ pub fn segment_collection(
     };
     let t = Instant::now();
     let timer = crate::stage_timer::stage("parts: heat smoothers");
-    let smoothers = match refine {
-        Some(r) if smoothing => Some(
+    let fits = |r: &RefineOptions, s: &[HeatSmoother]| {
+        s.len() == meshes.len()
+            && s.iter()
+                .zip(meshes)
+                .all(|(h, m)| h.time() == r.smoothing_time && h.vertex_count() == m.vertex_count())
+    };
+    let shared = match refine {
+        Some(r) if smoothing => shared.filter(|s| fits(r, s)),
+        _ => None,
+    };
+    let made = match refine {
+        Some(r) if smoothing && shared.is_none() => Some(
             meshes
                 .par_iter()
                 .enumerate()
@@ -715,6 +738,7 @@ pub fn segment_collection(
         ),
         _ => None,
     };
+    let smoothers: Option<&[HeatSmoother]> = shared.or(made.as_deref());
     times.smoothers = t.elapsed();
     drop(timer);
     let cues = match geometry {
@@ -773,13 +797,8 @@ pub fn segment_collection(
                 Some(_) => RefineSizes::Free,
                 None => options.refine_sizes,
             };
-            segmentation = refine_cosegmentation_sized(
-                &graph,
-                &segmentation,
-                smoothers.as_deref(),
-                refine,
-                sizes,
-            )?;
+            segmentation =
+                refine_cosegmentation_sized(&graph, &segmentation, smoothers, refine, sizes)?;
             times.refine += t.elapsed();
         }
         // Parts from geometry: the refined equal-area regions, split into their kinds of

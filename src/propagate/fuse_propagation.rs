@@ -9,7 +9,7 @@ use super::{
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
 use crate::parts::{
-    FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions, segment_collection,
+    FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions, segment_collection_sharing,
 };
 use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
@@ -122,11 +122,25 @@ impl CollectionParts {
     /// The co-segmentation into `count` parts of [`PartsFrom::Geometry`] (made on the first
     /// call for `count`).
     ///
-    /// Errors: those of [`segment_collection`].
+    /// Errors: those of [`segment_collection`](crate::parts::segment_collection).
     pub fn parts(
         &mut self,
         count: usize,
         meshes: &[TriMesh],
+    ) -> Result<&Cosegmentation, GraphError> {
+        self.parts_smoothed(count, meshes, None)
+    }
+
+    /// [`Self::parts`] with the refinement reading `smoothers` (one per mesh, as the
+    /// propagation made them) where their time is the refinement's: the same co-segmentation,
+    /// without a second heat smoother per shape.
+    ///
+    /// Errors: those of [`segment_collection`](crate::parts::segment_collection).
+    pub fn parts_smoothed(
+        &mut self,
+        count: usize,
+        meshes: &[TriMesh],
+        smoothers: Option<&[HeatSmoother]>,
     ) -> Result<&Cosegmentation, GraphError> {
         if !self.made.contains_key(&count) {
             let mut o = self.options.clone();
@@ -138,7 +152,7 @@ impl CollectionParts {
                 },
                 None,
             );
-            let s = segment_collection(self.nodes.clone(), meshes, &o)?;
+            let s = segment_collection_sharing(self.nodes.clone(), meshes, &o, smoothers)?;
             let intrinsic = s.features.as_ref().map_or(self.intrinsic_pipeline, |c| {
                 c.chosen == FeatureSet::Intrinsic
             });
@@ -224,7 +238,7 @@ pub fn fuse_propagation(
     if let (true, Some(parts)) = (options.parts, parts) {
         let count = propagation.parts.len();
         let _t = crate::stage_timer::stage("parts route (co-segmentation)");
-        match parts.parts(count, meshes) {
+        match parts.parts_smoothed(count, meshes, smoothers) {
             Ok(_) => {
                 parts_intrinsic = parts.intrinsic_only(count).unwrap_or(true);
                 let seg = parts.parts(count, meshes)?;
@@ -277,7 +291,12 @@ pub fn fuse_propagation(
         affine: options.affine,
     };
     let timer = crate::stage_timer::stage("held-out routes on the sources");
-    report.held_out_runs = held_out_routes_cached(&held_out, &propagation.rigid, rigid_poses)?;
+    report.held_out_runs = held_out_routes_cached(
+        &held_out,
+        &propagation.rigid,
+        rigid_poses,
+        Some(propagation),
+    )?;
     drop(timer);
     let _t = crate::stage_timer::stage("fusion and snapping");
     report.held_out = report.held_out_runs.as_ref().map(|h| h.accuracy.clone());

@@ -2,7 +2,8 @@
 //! source's labels carried to it from the other sources.
 
 use super::rigid_route::{RigidCache, rigid_route_weighed};
-use super::{PropagateError, PropagateOptions, Route, parts_route, propagate_labels};
+use super::solve::propagate_labels_from;
+use super::{PropagateError, PropagateOptions, Propagation, Route, parts_route};
 use crate::graph::{Cosegmentation, ShapeGraph};
 use crate::mesh::TriMesh;
 use crate::spectral::HeatSmoother;
@@ -43,7 +44,7 @@ pub struct HeldOutInputs<'a> {
 /// Output: per route of `inputs.routes`, its mean held-out accuracy in `[0, 1]`; `None` with
 /// fewer than two annotated shapes (nothing to hold out from).
 ///
-/// Errors: those of [`propagate_labels`] other than a held-out run left without labels
+/// Errors: those of [`super::propagate_labels`] other than a held-out run left without labels
 /// (a source whose labels no other source has is skipped).
 ///
 /// Known issue: each source is reached from one source fewer than the targets are, so the
@@ -75,17 +76,21 @@ pub struct HeldOutRoutes {
 /// [`held_out_accuracy`] with every held-out run's labels ([`HeldOutRoutes`]); same inputs
 /// and errors.
 pub fn held_out_routes(inputs: &HeldOutInputs) -> Result<Option<HeldOutRoutes>, PropagateError> {
-    held_out_routes_cached(inputs, &RigidCache::default(), false)
+    held_out_routes_cached(inputs, &RigidCache::default(), false, None)
 }
 
 /// [`held_out_routes`] with the rigid route's registrations kept in `rigid` (the fusion
 /// shares its propagation's cache, whose pairs of sources the held-out runs need) and, with
 /// `rigid_poses`, the rigid route's pose chosen among its alternatives as the fusion chooses
-/// it ([`choose_rigid_alternative`] against the routes scored before it).
+/// it ([`choose_rigid_alternative`] against the routes scored before it). `affinity`: the
+/// band-affinity propagation of all the sources, whose cached votes each held-out solve starts
+/// from ([`propagate_labels_from`]: the same labels, the votes of the other sources not
+/// transported again).
 pub(crate) fn held_out_routes_cached(
     inputs: &HeldOutInputs,
     rigid: &RigidCache,
     rigid_poses: bool,
+    affinity: Option<&Propagation>,
 ) -> Result<Option<HeldOutRoutes>, PropagateError> {
     let HeldOutInputs {
         graph,
@@ -133,14 +138,16 @@ pub(crate) fn held_out_routes_cached(
         for route in routes {
             let _t = crate::stage_timer::stage(format!("held-out {route:?} on source {s}"));
             let (l, c, e): (Vec<i32>, Vec<f64>, f64) = match route {
-                Route::Affinity => match propagate_labels(graph, smoothers, &ann, propagate) {
-                    Ok(p) => (p.labels[s].clone(), p.confidence[s].clone(), f64::NAN),
-                    Err(PropagateError::NoLabels) => {
-                        skipped = true;
-                        break;
+                Route::Affinity => {
+                    match propagate_labels_from(graph, smoothers, &ann, propagate, affinity) {
+                        Ok(p) => (p.labels[s].clone(), p.confidence[s].clone(), f64::NAN),
+                        Err(PropagateError::NoLabels) => {
+                            skipped = true;
+                            break;
+                        }
+                        Err(e) => return Err(e),
                     }
-                    Err(e) => return Err(e),
-                },
+                }
                 Route::Parts => match segmentation {
                     Some(seg) => {
                         let r = parts_route(seg, &ann, &areas);

@@ -5,13 +5,13 @@ use super::RouteLabels;
 use super::fuse_routes::cohen_kappa;
 use super::refine_affine::refine_affine;
 use crate::align::{
-    Candidate, RegisterOptions, Registration, Similarity, SurfaceIndex,
-    nearest_point_vertex_labels, register_pair,
+    Candidate, Prepared, RegisterOptions, Registration, Similarity, SurfaceIndex,
+    nearest_point_vertex_labels_in, register_onto,
 };
 use crate::mesh::TriMesh;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// The rigid route of the fused propagation: every unlabelled shape is registered onto each
 /// source by a similarity ([`register_pair`]: rotation, uniform scale, translation, any pose)
@@ -84,6 +84,23 @@ type Nearest = (Vec<i32>, Vec<f64>, f64);
 #[derive(Debug, Default)]
 pub(crate) struct RigidCache {
     pairs: Mutex<BTreeMap<PairKey, PairFit>>,
+    /// Per source (index, vertex count): its registration samples and surface index, made
+    /// once for all the targets read from it (a few sources, every target: the same work
+    /// per pair would be repeated `#targets` times).
+    sources: Mutex<BTreeMap<(usize, usize), Arc<SourceIndex>>>,
+}
+
+/// What every pair with one source reads of it: its samples for [`register_onto`] (or why
+/// they could not be made) and its surface index for the nearest points.
+struct SourceIndex {
+    prepared: Result<Prepared, String>,
+    surface: SurfaceIndex,
+}
+
+impl std::fmt::Debug for SourceIndex {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("SourceIndex").finish_non_exhaustive()
+    }
 }
 
 /// (source, target, source vertices, target vertices, affine step).
@@ -93,6 +110,7 @@ impl Clone for RigidCache {
     fn clone(&self) -> Self {
         RigidCache {
             pairs: Mutex::new(self.lock().clone()),
+            sources: Mutex::new(self.lock_sources().clone()),
         }
     }
 }
@@ -109,6 +127,27 @@ impl RigidCache {
     fn lock(&self) -> std::sync::MutexGuard<'_, BTreeMap<PairKey, PairFit>> {
         // A panic elsewhere cannot leave an entry half written (entries are inserted whole).
         self.pairs.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn lock_sources(
+        &self,
+    ) -> std::sync::MutexGuard<'_, BTreeMap<(usize, usize), Arc<SourceIndex>>> {
+        self.sources.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Source `s`'s samples and surface index (made on the first call; two threads asking
+    /// at once may both make it, and the first one stored is kept: they are equal).
+    fn source(&self, meshes: &[TriMesh], s: usize) -> Arc<SourceIndex> {
+        let key = (s, meshes[s].vertex_count());
+        if let Some(x) = self.lock_sources().get(&key) {
+            return x.clone();
+        }
+        let o = RegisterOptions::default();
+        let made = Arc::new(SourceIndex {
+            prepared: Prepared::new(&meshes[s], o.samples, o.seed).map_err(|e| e.to_string()),
+            surface: SurfaceIndex::new(&meshes[s]),
+        });
+        self.lock_sources().entry(key).or_insert(made).clone()
     }
 
     fn key(meshes: &[TriMesh], s: usize, i: usize, affine: bool) -> PairKey {
@@ -133,8 +172,12 @@ impl RigidCache {
         if let Some(f) = self.lock().get(&key) {
             return f.registration.clone();
         }
-        let registration = register_pair(&meshes[s], &meshes[i], &RegisterOptions::default())
-            .map_err(|e| e.to_string());
+        // `register_pair(source, target)` with the source prepared once.
+        let registration = match &self.source(meshes, s).prepared {
+            Ok(source) => register_onto(source, &meshes[i], &RegisterOptions::default())
+                .map_err(|e| e.to_string()),
+            Err(e) => Err(e.clone()),
+        };
         self.lock()
             .entry(key)
             .or_insert(PairFit {
@@ -169,10 +212,14 @@ impl RigidCache {
         // vertex the index of the vertex whose label it would read.
         let index: Vec<i32> = (0..meshes[s].vertex_count() as i32).collect();
         let mut residual = pose.residual;
+        let source = self.source(meshes, s);
+        let nearest_labels = |target: &TriMesh, transform: &Similarity| {
+            nearest_point_vertex_labels_in(&source.surface, &meshes[s], &index, target, transform)
+        };
         let carried = if affine {
             let fit = refine_affine(
                 &meshes[s],
-                &SurfaceIndex::new(&meshes[s]),
+                &source.surface,
                 &meshes[i],
                 &pose.transform,
                 AFFINE_TRIM,
@@ -183,18 +230,11 @@ impl RigidCache {
                 residual = pose.residual * (fit.residual / fit.start_residual).min(1.0);
             }
             match meshes[i].map_positions(|p| fit.map.apply(p)) {
-                Ok(mapped) => nearest_point_vertex_labels(
-                    &meshes[s],
-                    &index,
-                    &mapped,
-                    &Similarity::identity(),
-                ),
-                Err(_) => {
-                    nearest_point_vertex_labels(&meshes[s], &index, &meshes[i], &pose.transform)
-                }
+                Ok(mapped) => nearest_labels(&mapped, &Similarity::identity()),
+                Err(_) => nearest_labels(&meshes[i], &pose.transform),
             }
         } else {
-            nearest_point_vertex_labels(&meshes[s], &index, &meshes[i], &pose.transform)
+            nearest_labels(&meshes[i], &pose.transform)
         }
         .map(|(v, d)| (v, d, residual))
         .map_err(|e| e.to_string())?;

@@ -96,6 +96,24 @@ pub fn propagate_labels(
     annotations: &[Option<Vec<i32>>],
     options: &PropagateOptions,
 ) -> Result<Propagation, PropagateError> {
+    propagate_labels_from(graph, smoothers, annotations, options, None)
+}
+
+/// [`propagate_labels`] starting from the votes `earlier` cached on the same graph (another
+/// propagation of it, e.g. with one more source): a cached vote is used only where its voter's
+/// labels are the ones the new run votes with (the cache's own rule), so the result is
+/// [`propagate_labels`]'s, bit for bit; the votes of the sources both runs share are not
+/// transported again. Only the votes of shapes that are sources here are taken: a relay's
+/// vote is taken from `earlier` only if it is recomputed-equal anyway, and copying them all
+/// would hold a second cache. Ignored when the runs' parts or score rules differ (a vote's
+/// columns are the parts in order).
+pub(crate) fn propagate_labels_from(
+    graph: &ShapeGraph,
+    smoothers: Option<&[HeatSmoother]>,
+    annotations: &[Option<Vec<i32>>],
+    options: &PropagateOptions,
+    earlier: Option<&Propagation>,
+) -> Result<Propagation, PropagateError> {
     options.validate()?;
     let n = graph.node_count();
     if annotations.len() != n {
@@ -145,6 +163,17 @@ pub fn propagate_labels(
     for (i, a) in annotations.iter().enumerate() {
         if let Some(a) = a {
             p.set_annotation(graph, i, a)?;
+        }
+    }
+    if let Some(e) =
+        earlier.filter(|e| e.parts == p.parts && e.vote_rule == p.vote_rule && e.state.len() == n)
+    {
+        for (&(j, i), labels) in &e.vote_labels {
+            let same = p.sources[j] && p.vote_source(j) == labels.as_slice();
+            if let (true, Some(v)) = (same, e.votes.get(&(j, i))) {
+                p.votes.insert((j, i), v.clone());
+                p.vote_labels.insert((j, i), labels.clone());
+            }
         }
     }
     p.run(graph, smoothers, options, None)?;
@@ -307,24 +336,52 @@ impl Propagation {
         }
     }
 
-    /// The vote of `j` on `i` (cached while `j`'s labels are unchanged); returns whether it
-    /// was computed.
-    fn ensure_vote(
+    /// Whether the vote of `j` on `i` must be computed: it is cached while `j`'s labels are
+    /// unchanged.
+    fn vote_is_stale(&self, j: usize, i: usize) -> bool {
+        let src = self.vote_source(j);
+        !self
+            .vote_labels
+            .get(&(j, i))
+            .is_some_and(|l| l.as_slice() == src)
+    }
+
+    /// Computes the stale votes among `pairs` (`(j, i)`: `j`'s vote on `i`) side by side and
+    /// caches them; returns how many were computed. Each vote reads the current labels alone,
+    /// so the result is the same in any order; they are inserted in the order of `pairs`.
+    fn ensure_votes(
         &mut self,
+        graph: &ShapeGraph,
+        pairs: &[(usize, usize)],
+        options: &PropagateOptions,
+    ) -> Result<usize, PropagateError> {
+        let stale: Vec<(usize, usize)> = pairs
+            .iter()
+            .copied()
+            .filter(|&(j, i)| self.vote_is_stale(j, i))
+            .collect();
+        let this = &*self;
+        let computed: Vec<Vec<f64>> = stale
+            .par_iter()
+            .map(|&(j, i)| this.compute_vote(graph, j, i, options))
+            .collect::<Result<_, _>>()?;
+        for (&(j, i), scores) in stale.iter().zip(computed) {
+            let src = self.vote_source(j).to_vec();
+            self.votes.insert((j, i), scores);
+            self.vote_labels.insert((j, i), src);
+        }
+        Ok(stale.len())
+    }
+
+    /// The vote of `j` on `i` from `j`'s current labels.
+    fn compute_vote(
+        &self,
         graph: &ShapeGraph,
         j: usize,
         i: usize,
         options: &PropagateOptions,
-    ) -> Result<bool, PropagateError> {
+    ) -> Result<Vec<f64>, PropagateError> {
         let src = self.vote_source(j);
-        if self
-            .vote_labels
-            .get(&(j, i))
-            .is_some_and(|l| l.as_slice() == src)
-        {
-            return Ok(false);
-        }
-        let src = src.to_vec();
         let regions = self.parts.len();
         let own;
         let (w, dir) = match graph.affinity(j, i) {
@@ -342,10 +399,7 @@ impl Propagation {
                 (w, dir)
             }
         };
-        let scores = vote_scores(&w, dir, &src, &graph.node(j).areas, regions, options)?;
-        self.votes.insert((j, i), scores);
-        self.vote_labels.insert((j, i), src);
-        Ok(true)
+        vote_scores(&w, dir, src, &graph.node(j).areas, regions, options)
     }
 }
 
@@ -497,18 +551,17 @@ impl Propagation {
                     .map(|(j, c)| (j, (c * WEIGHT_STEPS).round() / WEIGHT_STEPS))
                     .filter(|&(_, c)| c > 0.0)
                     .collect();
-                let mut computed = 0;
-                for &(j, _) in &voters {
-                    let cached_relay = quick.is_some_and(|c| c != j)
-                        && !self.sources[j]
-                        && self.votes.contains_key(&(j, i));
-                    if cached_relay {
-                        continue;
-                    }
-                    if self.ensure_vote(graph, j, i, options)? {
-                        computed += 1;
-                    }
-                }
+                let wanted: Vec<(usize, usize)> = voters
+                    .iter()
+                    .filter(|&&(j, _)| {
+                        let cached_relay = quick.is_some_and(|c| c != j)
+                            && !self.sources[j]
+                            && self.votes.contains_key(&(j, i));
+                        !cached_relay
+                    })
+                    .map(|&(j, _)| (j, i))
+                    .collect();
+                let computed = self.ensure_votes(graph, &wanted, options)?;
                 if computed == 0 && last_voters[i].as_ref() == Some(&voters) {
                     continue;
                 }
