@@ -467,6 +467,45 @@ fn large_collections_get_a_connected_nearest_neighbour_graph() {
 }
 
 #[test]
+fn the_nearest_neighbour_graph_is_the_same_on_one_thread_and_on_many() {
+    // Neighbours and the spanning tree's updates are searched in parallel: the edges must be
+    // those of one thread, in the same order, and each shape's neighbours the `k` nearest by
+    // (distance, index) among all others.
+    let (tables, areas) = noisy_collection(40, 30, 5);
+    let mut opts = GraphOptions::default();
+    opts.complete_limit = 10;
+    opts.neighbours = 3;
+    let build = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        pool.install(|| ShapeGraph::build(nodes_from(&tables, &areas), &opts).unwrap())
+    };
+    let edges = |g: &ShapeGraph| -> Vec<(usize, usize, u64)> {
+        g.edges()
+            .iter()
+            .map(|(i, j, e)| (*i, *j, e.weight.to_bits()))
+            .collect()
+    };
+    let one = build(1);
+    assert_eq!(edges(&one), edges(&build(4)));
+    for i in 0..40 {
+        let mut others: Vec<(f64, usize)> = (0..40)
+            .filter(|&j| j != i)
+            .map(|j| (one.summary_distance(i, j), j))
+            .collect();
+        others.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        for &(_, j) in &others[..3] {
+            assert!(
+                one.edge(i, j).is_some(),
+                "{i}'s near neighbour {j} is not linked"
+            );
+        }
+    }
+}
+
+#[test]
 fn graph_rejects_incompatible_shapes() {
     let a = random_table(20, 8, 4, 1);
     let b = random_table(20, 8, 5, 2);

@@ -787,3 +787,39 @@ fn a_parts_route_collapsed_with_the_affinity_does_not_outvote_the_rigid_route() 
         fuse_routes_with(&refs, &area_refs, None, Some((0, 1)))
     );
 }
+
+#[test]
+fn the_parts_route_reading_the_propagations_smoothers_equals_one_making_its_own() {
+    // The parts route's refinement reads the heat smoothers the propagation made (same time)
+    // instead of factoring a second set: its co-segmentation must be the one made from
+    // nothing, bit for bit.
+    use coseg::propagate::{CollectionParts, PropagateCollectionOptions, propagate_loaded};
+    let dir = tempfile::tempdir().unwrap();
+    let (folder, truth) = four_goblets(dir.path());
+    let mut o = PropagateCollectionOptions::default();
+    o.pipeline = common::features::small_pipeline(30, 8);
+    o.cache_dir = Some(dir.path().join("cache"));
+    let loaded = coseg::graph::load_collection(
+        &folder,
+        &o.pipeline,
+        o.cache_dir.as_ref().unwrap(),
+        |_, _, _| {},
+    )
+    .unwrap();
+    let nodes = loaded.nodes.clone();
+    let meshes = loaded.meshes;
+    let annotations = vec![Some(truth[0].clone()), Some(truth[1].clone()), None, None];
+    let mut out = propagate_loaded(loaded.nodes, &meshes, &annotations, &o).unwrap();
+    assert!(!out.smoothers.is_empty(), "the default propagation smooths");
+    let count = out.propagation.parts.len();
+    let shared = out
+        .parts
+        .as_mut()
+        .expect("the parts route is on by default")
+        .parts(count, &meshes)
+        .unwrap()
+        .clone();
+    let mut fresh = CollectionParts::new(nodes, &o.pipeline, &o.graph, o.cache_dir.clone());
+    let own = fresh.parts(count, &meshes).unwrap();
+    assert_eq!(&shared, own);
+}
