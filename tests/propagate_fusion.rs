@@ -437,21 +437,19 @@ fn four_goblets(dir: &std::path::Path) -> (std::path::PathBuf, Vec<Vec<i32>>) {
     (folder, truth)
 }
 
-#[test]
-fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() {
-    // The propagation keeps the rigid route's registrations and nearest points between
-    // fusions; after an update that adds a second source (new pairs, and kept ones from the
-    // first fusion), the rigid route and the held-out accuracies must be those computed from
-    // nothing, bit for bit.
-    use coseg::propagate::{
-        HeldOutInputs, PropagateCollectionOptions, Route, fuse_propagation, held_out_accuracy,
-        propagate_loaded, rigid_route,
-    };
-    let dir = tempfile::tempdir().unwrap();
-    let (folder, truth) = four_goblets(dir.path());
-    let mut o = PropagateCollectionOptions::default();
+/// [`four_goblets`] through the per-shape stage (a small pipeline, cache in `dir/cache`), with
+/// the default propagation options on that pipeline.
+fn four_goblets_loaded(
+    dir: &std::path::Path,
+) -> (
+    coseg::propagate::PropagateCollectionOptions,
+    coseg::graph::LoadedCollection,
+    Vec<Vec<i32>>,
+) {
+    let (folder, truth) = four_goblets(dir);
+    let mut o = coseg::propagate::PropagateCollectionOptions::default();
     o.pipeline = common::features::small_pipeline(30, 8);
-    o.cache_dir = Some(dir.path().join("cache"));
+    o.cache_dir = Some(dir.join("cache"));
     let loaded = coseg::graph::load_collection(
         &folder,
         &o.pipeline,
@@ -459,6 +457,20 @@ fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() 
         |_, _, _| {},
     )
     .unwrap();
+    (o, loaded, truth)
+}
+
+#[test]
+fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() {
+    // The propagation keeps the rigid route's registrations and nearest points between
+    // fusions; after an update that adds a second source (new pairs, and kept ones from the
+    // first fusion), the rigid route and the held-out accuracies must be those computed from
+    // nothing, bit for bit.
+    use coseg::propagate::{
+        HeldOutInputs, Route, fuse_propagation, held_out_accuracy, propagate_loaded, rigid_route,
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let (o, loaded, truth) = four_goblets_loaded(dir.path());
     let meshes = loaded.meshes;
     // An update knows the first run's parts only: other labels of the second source are left
     // unlabelled.
@@ -793,19 +805,9 @@ fn the_parts_route_reading_the_propagations_smoothers_equals_one_making_its_own(
     // The parts route's refinement reads the heat smoothers the propagation made (same time)
     // instead of factoring a second set: its co-segmentation must be the one made from
     // nothing, bit for bit.
-    use coseg::propagate::{CollectionParts, PropagateCollectionOptions, propagate_loaded};
+    use coseg::propagate::{CollectionParts, propagate_loaded};
     let dir = tempfile::tempdir().unwrap();
-    let (folder, truth) = four_goblets(dir.path());
-    let mut o = PropagateCollectionOptions::default();
-    o.pipeline = common::features::small_pipeline(30, 8);
-    o.cache_dir = Some(dir.path().join("cache"));
-    let loaded = coseg::graph::load_collection(
-        &folder,
-        &o.pipeline,
-        o.cache_dir.as_ref().unwrap(),
-        |_, _, _| {},
-    )
-    .unwrap();
+    let (o, loaded, truth) = four_goblets_loaded(dir.path());
     let nodes = loaded.nodes.clone();
     let meshes = loaded.meshes;
     let annotations = vec![Some(truth[0].clone()), Some(truth[1].clone()), None, None];

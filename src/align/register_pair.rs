@@ -136,8 +136,7 @@ pub fn register_pair(
 ) -> Result<Registration, AlignError> {
     options.check()?;
     let s = Prepared::new(source, options.samples, options.seed)?;
-    let t = Prepared::new(target, options.samples, options.seed)?;
-    Ok(register_prepared(&s, &t, options))
+    register_onto(&s, target, options)
 }
 
 /// [`register_pair`] with the source already prepared (`Prepared::new(source, options.samples,

@@ -340,10 +340,9 @@ impl Propagation {
     /// unchanged.
     fn vote_is_stale(&self, j: usize, i: usize) -> bool {
         let src = self.vote_source(j);
-        !self
-            .vote_labels
+        self.vote_labels
             .get(&(j, i))
-            .is_some_and(|l| l.as_slice() == src)
+            .is_none_or(|l| l.as_slice() != src)
     }
 
     /// Computes the stale votes among `pairs` (`(j, i)`: `j`'s vote on `i`) side by side and
