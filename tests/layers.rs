@@ -7,8 +7,10 @@
 use std::path::Path;
 
 /// Earlier stages first. `vertex_sets` (sorted-set helpers), `labels` (label files) and
-/// `generate` (synthetic inputs) depend only on `mesh`; `cache` only stores entries.
+/// `generate` (synthetic inputs) depend only on `mesh`; `cache` only stores entries;
+/// `stage_timer` (the `COSEG_TIMINGS` profile lines) depends on nothing and every stage uses it.
 const ORDER: &[&str] = &[
+    "stage_timer",
     "vertex_sets",
     "mesh",
     "labels",
