@@ -10,31 +10,12 @@ Pure Python, deterministic.
 """
 import os, sys
 
-
-def read_off(path):
-    with open(path) as f:
-        toks = f.read().split()
-    i = 1 if toks[0].upper() == "OFF" else 0
-    nv, nf = int(toks[i]), int(toks[i + 1])
-    i += 3
-    pos = [tuple(map(float, toks[i + 3 * k:i + 3 * k + 3])) for k in range(nv)]
-    i += 3 * nv
-    faces = []
-    for _ in range(nf):
-        n = int(toks[i])
-        faces.append(tuple(int(t) for t in toks[i + 1:i + 1 + n])[:3])
-        i += 1 + n
-    return pos, faces
+from off_mesh import face_areas, read_off
 
 
 def vertex_areas(pos, faces):
     w = [0.0] * len(pos)
-    for a, b, c in faces:
-        pa, pb, pc = pos[a], pos[b], pos[c]
-        u = [pb[k] - pa[k] for k in range(3)]
-        v = [pc[k] - pa[k] for k in range(3)]
-        x = (u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0])
-        ar = 0.5 * (x[0] ** 2 + x[1] ** 2 + x[2] ** 2) ** 0.5
+    for (a, b, c), ar in zip(faces, face_areas(pos, faces)):
         for i in (a, b, c):
             w[i] += ar / 3.0
     t = sum(w)

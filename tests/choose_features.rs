@@ -9,7 +9,6 @@ use coseg::parts::{
     ChooseFeaturesOptions, FeatureSelection, FeatureSet, PartsFrom, SegmentCollectionOptions,
     segment_collection,
 };
-use coseg::pipeline::compute_shape_data;
 
 /// Three shipped goblets with the small test pipeline's spectral columns.
 fn goblets() -> (Vec<TriMesh>, Vec<ShapeNode>) {
@@ -18,14 +17,7 @@ fn goblets() -> (Vec<TriMesh>, Vec<ShapeNode>) {
     let meshes: Vec<TriMesh> = (0..3)
         .map(|i| read_mesh(dir.join(format!("goblets_{i:02}.obj"))).unwrap())
         .collect();
-    let nodes = meshes
-        .iter()
-        .enumerate()
-        .map(|(i, m)| {
-            let d = compute_shape_data(m, &o).unwrap();
-            ShapeNode::new(format!("g{i}"), d.bands, &d.descriptors.vertex_areas).unwrap()
-        })
-        .collect();
+    let nodes = common::graph::shape_nodes(&meshes, &o, "g");
     (meshes, nodes)
 }
 

@@ -193,6 +193,12 @@ fn studio_refuses_requests_without_the_token_from_elsewhere_or_outside_the_folde
     let (code, page) = request(s.port, "GET", &format!("/?token={token}"), &[], "");
     assert_eq!(code, 200);
     assert!(page.contains("coseg studio"));
+    // The WebGL helpers and program shared with the viewer page are filled in.
+    assert!(
+        !page.contains("__GL_"),
+        "a placeholder of the page was left"
+    );
+    assert!(page.contains("function normals(pos, idx)") && page.contains("var loc = {"));
     let cookie = format!("coseg_token={token}");
     let (code, _) = request(s.port, "GET", "/api/state", &[("Cookie", &cookie)], "");
     assert_eq!(code, 200);

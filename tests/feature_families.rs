@@ -406,9 +406,7 @@ fn a_missing_user_file_names_the_folder_and_the_shape() {
 #[test]
 fn a_collection_mixing_families_is_deterministic_bit_for_bit() {
     use coseg::features::{FeatureFamilies, parse_families};
-    use coseg::graph::ShapeNode;
     use coseg::parts::{SegmentCollectionOptions, segment_collection};
-    use coseg::pipeline::compute_shape_data;
     let meshes = [blob(2), similarity(&blob(2), 2.0), icosphere(2)];
     let mut o = small_pipeline();
     let (_, fam): (bool, FeatureFamilies) =
@@ -416,14 +414,7 @@ fn a_collection_mixing_families_is_deterministic_bit_for_bit() {
     o.families = fam;
     o.families.weights.sdf = 2.0;
     let run = || {
-        let nodes: Vec<ShapeNode> = meshes
-            .iter()
-            .enumerate()
-            .map(|(i, m)| {
-                let d = compute_shape_data(m, &o).unwrap();
-                ShapeNode::new(format!("s{i}"), d.bands, &d.descriptors.vertex_areas).unwrap()
-            })
-            .collect();
+        let nodes = common::graph::shape_nodes(&meshes, &o, "s");
         let features = nodes[0].bands.features;
         let mut s = SegmentCollectionOptions::equal_areas(3);
         s.feature_weights = o.feature_weights(features);

@@ -519,22 +519,17 @@ fn map_step_corrects_a_misplaced_boundary_on_an_isometric_copy() {
 /// without the flag the summary has no map-step field (the default output is unchanged).
 #[test]
 fn coseg_propagate_map_step_on_isometric_copies() {
-    use common::features::{blob, permutation, permute_mesh};
+    use common::features::labelled_blob_and_copies;
     let dir = tempfile::tempdir().unwrap();
-    let shapes = dir.path().join("shapes");
-    std::fs::create_dir(&shapes).unwrap();
-    let mesh = blob(3);
-    let (truth, _) = blob_parts(&mesh);
-    coseg::mesh::write_mesh(shapes.join("a.off"), &mesh, &[]).unwrap();
-    coseg::labels::write_vertex_labels(dir.path(), "a", &truth).unwrap();
-    let mut copies = Vec::new();
-    for (k, seed) in [(1, 11u64), (2, 12)] {
-        let perm = permutation(mesh.vertex_count(), seed);
-        let copy = permute_mesh(&mesh, &perm);
-        coseg::mesh::write_mesh(shapes.join(format!("c{k}.off")), &copy, &[]).unwrap();
-        let truth_copy = blob_parts(&copy).0;
-        copies.push((format!("c{k}"), copy, truth_copy));
-    }
+    let (shapes, _, copies) = labelled_blob_and_copies(dir.path(), |m| blob_parts(m).0);
+    let copies: Vec<_> = copies
+        .into_iter()
+        .enumerate()
+        .map(|(k, copy)| {
+            let truth_copy = blob_parts(&copy).0;
+            (format!("c{}", k + 1), copy, truth_copy)
+        })
+        .collect();
     let run = |out: &std::path::Path, map: bool| {
         let mut extra = vec!["--eigenpairs", "40", "--no-pictures"];
         if map {

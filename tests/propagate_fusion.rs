@@ -166,13 +166,10 @@ fn parts_are_named_by_the_sources_majority_and_unknown_parts_say_so() {
 /// the boundaries onto creases that are not there.
 #[test]
 fn identical_copies_keep_the_sources_labels_under_the_default_fusion() {
-    use common::features::{blob, permutation, permute_mesh};
+    use common::features::labelled_blob_and_copies;
     use coseg::evaluate::vertex_label_agreement;
     use coseg::propagate::{PropagateCollectionOptions, RouteOptions, propagate_collection};
     let dir = tempfile::tempdir().unwrap();
-    let shapes = dir.path().join("shapes");
-    std::fs::create_dir(&shapes).unwrap();
-    let mesh = blob(3);
     let slab = |x: f64| {
         if x < -0.4 {
             0
@@ -185,14 +182,7 @@ fn identical_copies_keep_the_sources_labels_under_the_default_fusion() {
     let truth_of = |m: &coseg::mesh::TriMesh| -> Vec<i32> {
         m.positions().iter().map(|p| slab(p[0])).collect()
     };
-    coseg::mesh::write_mesh(shapes.join("a.off"), &mesh, &[]).unwrap();
-    coseg::labels::write_vertex_labels(dir.path(), "a", &truth_of(&mesh)).unwrap();
-    let mut copies = Vec::new();
-    for (k, seed) in [(1, 11u64), (2, 12)] {
-        let copy = permute_mesh(&mesh, &permutation(mesh.vertex_count(), seed));
-        coseg::mesh::write_mesh(shapes.join(format!("c{k}.off")), &copy, &[]).unwrap();
-        copies.push(copy);
-    }
+    let (shapes, _, copies) = labelled_blob_and_copies(dir.path(), truth_of);
     for (what, routes) in [
         ("default", RouteOptions::default()),
         ("affinity", RouteOptions::affinity_only()),

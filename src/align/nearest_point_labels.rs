@@ -3,7 +3,7 @@
 //! label transfer).
 
 use super::AlignError;
-use super::closest_surface_points::SurfaceIndex;
+use super::closest_surface_points::{SurfaceIndex, SurfacePoint};
 use super::similarity::Similarity;
 use crate::mesh::TriMesh;
 use rayon::prelude::*;
@@ -32,22 +32,11 @@ pub fn nearest_point_labels(
     target: &TriMesh,
     transform: &Similarity,
 ) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
-    if source_face_labels.len() != source.face_count() {
-        return Err(AlignError::LabelCount {
-            expected: source.face_count(),
-            found: source_face_labels.len(),
-            kind: "face",
-        });
-    }
+    one_each("face", source.face_count(), source_face_labels.len())?;
     let index = SurfaceIndex::new(source);
-    Ok(target
-        .positions()
-        .par_iter()
-        .map(|&p| {
-            let c = index.closest(transform.apply(p));
-            (source_face_labels[c.face], c.distance)
-        })
-        .unzip())
+    Ok(nearest(&index, target, transform, |c| {
+        source_face_labels[c.face]
+    }))
 }
 
 /// [`nearest_point_labels`] with per-vertex source labels: each target vertex takes the label
@@ -82,26 +71,46 @@ pub(crate) fn nearest_point_vertex_labels_in(
     target: &TriMesh,
     transform: &Similarity,
 ) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
-    if source_vertex_labels.len() != source.vertex_count() {
-        return Err(AlignError::LabelCount {
-            expected: source.vertex_count(),
-            found: source_vertex_labels.len(),
-            kind: "vertex",
-        });
-    }
+    one_each("vertex", source.vertex_count(), source_vertex_labels.len())?;
     let faces = source.faces();
-    Ok(target
+    Ok(nearest(index, target, transform, |c| {
+        let mut k = 0;
+        for i in 1..3 {
+            if c.barycentric[i] > c.barycentric[k] {
+                k = i;
+            }
+        }
+        source_vertex_labels[faces[c.face][k] as usize]
+    }))
+}
+
+/// Checks that there is one source label per face or vertex (`kind`).
+fn one_each(kind: &'static str, expected: usize, found: usize) -> Result<(), AlignError> {
+    if found == expected {
+        Ok(())
+    } else {
+        Err(AlignError::LabelCount {
+            expected,
+            found,
+            kind,
+        })
+    }
+}
+
+/// Per target vertex (moved by `transform`), the label `label` reads off the closest point
+/// of the source surface, and the distance to it.
+fn nearest(
+    index: &SurfaceIndex,
+    target: &TriMesh,
+    transform: &Similarity,
+    label: impl Fn(&SurfacePoint) -> i32 + Sync,
+) -> (Vec<i32>, Vec<f64>) {
+    target
         .positions()
         .par_iter()
         .map(|&p| {
             let c = index.closest(transform.apply(p));
-            let mut k = 0;
-            for i in 1..3 {
-                if c.barycentric[i] > c.barycentric[k] {
-                    k = i;
-                }
-            }
-            (source_vertex_labels[faces[c.face][k] as usize], c.distance)
+            (label(&c), c.distance)
         })
-        .unzip())
+        .unzip()
 }

@@ -142,6 +142,15 @@ pub fn strict() -> bool {
     global().strict
 }
 
+/// The cache of a command writing to an output folder: `--cache DIR` when given, otherwise
+/// `<OUT>/.cache` ([`coseg::jobs::CacheChoice::Auto`]).
+pub fn cache_or_auto(cache: &Option<std::path::PathBuf>) -> coseg::jobs::CacheChoice {
+    cache.clone().map_or(
+        coseg::jobs::CacheChoice::Auto,
+        coseg::jobs::CacheChoice::Dir,
+    )
+}
+
 /// Fails under `--strict` when `skipped` input files could not be used.
 pub fn check_strict(skipped: usize) -> anyhow::Result<()> {
     if global().strict && skipped > 0 {

@@ -3,7 +3,7 @@
 
 use anyhow::{Result, bail};
 use clap::Args;
-use coseg::jobs::{CacheChoice, PropagateInput, PropagateJob, run_propagate};
+use coseg::jobs::{PropagateInput, PropagateJob, run_propagate};
 use coseg::propagate::{MapStepOptions, PartScore, PropagateOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -109,10 +109,7 @@ fn propagate_job(args: &PropagateArgs) -> Result<PropagateJob> {
         options.map_step = Some(m);
     }
     options.part_names = args.part_names.clone();
-    job.cache = args
-        .cache
-        .clone()
-        .map_or(CacheChoice::Auto, CacheChoice::Dir);
+    job.cache = super::cache_or_auto(&args.cache);
     job.output = Some(args.out.clone());
     job.pictures = !args.no_pictures;
     Ok(job)

@@ -5,8 +5,7 @@ use clap::Args;
 use coseg::cache::CacheOutcome;
 use coseg::graph::{GraphError, RefineSizes};
 use coseg::jobs::{
-    CacheChoice, JobError, SegmentInput, SegmentJob, SegmentOutcome, SegmentProgress,
-    run_segment_with_progress,
+    JobError, SegmentInput, SegmentJob, SegmentOutcome, SegmentProgress, run_segment_with_progress,
 };
 use coseg::parts::{PartsFrom, PartsRequest};
 use std::path::PathBuf;
@@ -119,10 +118,7 @@ fn segment_job(args: &SegmentArgs) -> Result<SegmentJob> {
     if let Some(r) = args.refine_sizes {
         job.refine_sizes = r;
     }
-    job.cache = args
-        .cache
-        .clone()
-        .map_or(CacheChoice::Auto, CacheChoice::Dir);
+    job.cache = super::cache_or_auto(&args.cache);
     job.output = Some(args.out.clone());
     job.pictures = !args.no_pictures;
     job.strict = super::strict();

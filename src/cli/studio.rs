@@ -14,11 +14,19 @@ use serde_json::{Value, json};
 use std::io::{Read, Write};
 use std::path::PathBuf;
 use std::process::ExitCode;
-use std::sync::{Arc, Mutex, RwLock};
+use std::sync::{Arc, LazyLock, Mutex, RwLock};
 use tiny_http::{Header, Method, Request, Response, Server};
 
-/// The page: plain JavaScript and WebGL, embedded in the binary.
-const PAGE: &str = include_str!("studio.html");
+/// The page: plain JavaScript and WebGL, embedded in the binary; its WebGL helpers and shaded
+/// program are the viewer page's (`coseg::output::write_viewer`), from the same files.
+static PAGE: LazyLock<String> = LazyLock::new(|| {
+    include_str!("studio.html")
+        .replace(
+            "__GL_FUNCTIONS__\n",
+            include_str!("../output/gl_functions.js"),
+        )
+        .replace("__GL_PROGRAM__\n", include_str!("../output/gl_program.js"))
+});
 
 /// Largest request body read (a brush stroke over a whole large shape fits many times).
 const MAX_BODY: usize = 16 << 20;

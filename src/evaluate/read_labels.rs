@@ -1,6 +1,7 @@
 //! [`read_labels`]: one integer per line, as in `<name>.labels.txt` and `<name>.regions.txt`.
 
 use super::EvaluateError;
+use crate::labels::LabelError;
 use std::path::Path;
 
 /// Reads a per-vertex label file: one integer per line, in vertex order (blank lines are
@@ -19,11 +20,9 @@ use std::path::Path;
 /// ```
 pub fn read_labels(path: impl AsRef<Path>) -> Result<Vec<i32>, EvaluateError> {
     let path = path.as_ref();
-    let bytes = std::fs::read(path).map_err(|source| EvaluateError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
-    parse_labels(&bytes, &path.display().to_string())
+    crate::labels::read_label_file(path)
+        .map(|(_, labels)| labels)
+        .map_err(|e| evaluate_error(e, path))
 }
 
 /// [`read_labels`] on bytes held in memory; errors name `name`. Never panics, whatever the
@@ -35,20 +34,19 @@ pub fn read_labels(path: impl AsRef<Path>) -> Result<Vec<i32>, EvaluateError> {
 /// assert!(parse_labels(b"1\n\xff\n", "x.txt").unwrap_err().to_string().contains("x.txt:2:"));
 /// ```
 pub fn parse_labels(bytes: &[u8], name: &str) -> Result<Vec<i32>, EvaluateError> {
-    let mut labels = Vec::with_capacity(bytes.len() / 2);
-    for (i, line) in bytes.split(|&b| b == b'\n').enumerate() {
-        let bad = |text: String| EvaluateError::BadLabel {
-            path: name.to_string(),
-            line: i + 1,
-            text,
-        };
-        let t = std::str::from_utf8(line)
-            .map_err(|_| bad(String::from_utf8_lossy(line).chars().take(40).collect()))?
-            .trim();
-        if t.is_empty() {
-            continue;
-        }
-        labels.push(t.parse().map_err(|_| bad(t.chars().take(40).collect()))?);
+    crate::labels::parse_label_file(bytes, Path::new(name))
+        .map(|(_, labels)| labels)
+        .map_err(|e| evaluate_error(e, Path::new(name)))
+}
+
+/// The label module's error (one parser of label files serves both) as this module's.
+fn evaluate_error(e: LabelError, path: &Path) -> EvaluateError {
+    match e {
+        LabelError::Io { path, source } => EvaluateError::Io { path, source },
+        LabelError::BadLabel { path, line, text } => EvaluateError::BadLabel { path, line, text },
+        e => EvaluateError::BadManifest {
+            path: path.display().to_string(),
+            message: e.to_string(),
+        },
     }
-    Ok(labels)
 }

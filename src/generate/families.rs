@@ -29,6 +29,17 @@ fn clearance(cell: f64) -> f64 {
 }
 
 impl Clearance {
+    /// The segment `a`–`b` of radius `r` of part `part`.
+    fn segment(part: usize, a: V3, b: V3, r: f64, skip_torso: bool) -> Self {
+        Self {
+            part,
+            a,
+            b,
+            r,
+            skip_torso,
+        }
+    }
+
     fn holds(&self, model: &Model, clearance: f64) -> bool {
         let first = if self.skip_torso { 4 } else { 0 };
         (first..9).all(|k| {
@@ -53,6 +64,22 @@ fn part(primitives: Vec<Primitive>, blend: f64) -> Option<Part> {
 
 fn capsule(a: V3, b: V3, ra: f64, rb: f64) -> Primitive {
     Primitive::Capsule { a, b, ra, rb }
+}
+
+/// A two-segment limb from `root`: half of `len` along the unit direction `upper` to the joint,
+/// then half along `lower` to the end, with radius `radii` at the root, the joint and the end
+/// (the legs and arms of every family). Returns the joint, the end and the limb's part.
+fn limb(root: V3, upper: V3, lower: V3, len: f64, radii: [f64; 3]) -> (V3, V3, Option<Part>) {
+    let joint = add(root, scale(upper, 0.5 * len));
+    let end = add(joint, scale(lower, 0.5 * len));
+    let limb = part(
+        vec![
+            capsule(root, joint, radii[0], radii[1]),
+            capsule(joint, end, radii[1], radii[2]),
+        ],
+        0.03,
+    );
+    (joint, end, limb)
 }
 
 /// Builds shape number `index` of `family` from `params`; returns the model and the grid cell.
@@ -133,29 +160,10 @@ fn quadruped(index: usize, p: &mut Params, clear: f64) -> (Model, Vec<Clearance>
         let upper = mat_vec(&rotation(2, swing), DOWN);
         let bend = if front { -knee } else { knee };
         let lower = mat_vec(&rotation(2, swing + bend), DOWN);
-        let knee_p = add(hip, scale(upper, 0.5 * leg_len));
-        let foot = add(knee_p, scale(lower, 0.5 * leg_len));
-        checks.push(Clearance {
-            part: 2 + k,
-            a: knee_p,
-            b: foot,
-            r: rl,
-            skip_torso: true,
-        });
-        checks.push(Clearance {
-            part: 2 + k,
-            a: hip,
-            b: knee_p,
-            r: 1.15 * rl,
-            skip_torso: true,
-        });
-        legs.push(part(
-            vec![
-                capsule(hip, knee_p, 1.15 * rl, rl),
-                capsule(knee_p, foot, rl, 0.9 * rl),
-            ],
-            0.03,
-        ));
+        let (knee_p, foot, leg) = limb(hip, upper, lower, leg_len, [1.15 * rl, rl, 0.9 * rl]);
+        checks.push(Clearance::segment(2 + k, knee_p, foot, rl, true));
+        checks.push(Clearance::segment(2 + k, hip, knee_p, 1.15 * rl, true));
+        legs.push(leg);
     }
     let neck_angle = p.uniform("neck_angle", 0.3, 1.1);
     let neck_len = p.uniform("neck_length", 0.2, 0.5);
@@ -254,29 +262,10 @@ fn humanoid_arms(
         let base = rotation(2, side * abduct);
         let upper = mat_vec(&mat_mul(&base, &rotation(0, -swing)), DOWN);
         let lower = mat_vec(&mat_mul(&base, &rotation(0, -swing - elbow)), DOWN);
-        let elbow_p = add(shoulder, scale(upper, 0.5 * arm_len));
-        let hand = add(elbow_p, scale(lower, 0.5 * arm_len));
-        checks.push(Clearance {
-            part: 2 + k,
-            a: elbow_p,
-            b: hand,
-            r: ar,
-            skip_torso: false,
-        });
-        checks.push(Clearance {
-            part: 2 + k,
-            a: shoulder,
-            b: elbow_p,
-            r: 1.1 * ar,
-            skip_torso: true,
-        });
-        arms.push(part(
-            vec![
-                capsule(shoulder, elbow_p, 1.1 * ar, ar),
-                capsule(elbow_p, hand, ar, 0.95 * ar),
-            ],
-            0.03,
-        ));
+        let (elbow_p, hand, arm) = limb(shoulder, upper, lower, arm_len, [1.1 * ar, ar, 0.95 * ar]);
+        checks.push(Clearance::segment(2 + k, elbow_p, hand, ar, false));
+        checks.push(Clearance::segment(2 + k, shoulder, elbow_p, 1.1 * ar, true));
+        arms.push(arm);
     }
     arms
 }
@@ -307,22 +296,9 @@ fn humanoid_legs(
         let base = rotation(2, side * spread);
         let upper = mat_vec(&mat_mul(&base, &rotation(0, -swing)), DOWN);
         let lower = mat_vec(&mat_mul(&base, &rotation(0, -swing + knee)), DOWN);
-        let knee_p = add(hip, scale(upper, 0.5 * leg_len));
-        let foot = add(knee_p, scale(lower, 0.5 * leg_len));
-        checks.push(Clearance {
-            part: 4 + k,
-            a: knee_p,
-            b: foot,
-            r: lr,
-            skip_torso: true,
-        });
-        legs.push(part(
-            vec![
-                capsule(hip, knee_p, 1.1 * lr, lr),
-                capsule(knee_p, foot, lr, 0.9 * lr),
-            ],
-            0.03,
-        ));
+        let (knee_p, foot, leg) = limb(hip, upper, lower, leg_len, [1.1 * lr, lr, 0.9 * lr]);
+        checks.push(Clearance::segment(4 + k, knee_p, foot, lr, true));
+        legs.push(leg);
     }
     legs
 }

@@ -546,6 +546,27 @@ impl Pruning {
 }
 
 fn check(graph: &ShapeGraph, options: &CosegmentOptions) -> Result<(), GraphError> {
+    check_extraction(graph, options.root, options.max_sweeps)?;
+    if options.regions == 0 {
+        return Err(GraphError::BadOption("regions must be at least 1".into()));
+    }
+    let a = options.alpha();
+    if !(a.is_finite() && a > 0.0 && a <= 1.0) {
+        return Err(GraphError::BadOption(format!(
+            "area fraction {a} must be in (0, 1]"
+        )));
+    }
+    Ok(())
+}
+
+/// What every extraction of tuples needs of its graph and options (this one's [`cosegment`]
+/// and the adaptive one of `parts`): two shapes or more, a connected graph, a sweep, a root
+/// among the shapes and no shape without vertices.
+pub(crate) fn check_extraction(
+    graph: &ShapeGraph,
+    root: Option<usize>,
+    max_sweeps: usize,
+) -> Result<(), GraphError> {
     let n = graph.node_count();
     if n < 2 {
         return Err(GraphError::BadOption(format!(
@@ -557,24 +578,15 @@ fn check(graph: &ShapeGraph, options: &CosegmentOptions) -> Result<(), GraphErro
             "the shape graph is not connected".into(),
         ));
     }
-    if options.regions == 0 {
-        return Err(GraphError::BadOption("regions must be at least 1".into()));
-    }
-    let a = options.alpha();
-    if !(a.is_finite() && a > 0.0 && a <= 1.0) {
-        return Err(GraphError::BadOption(format!(
-            "area fraction {a} must be in (0, 1]"
-        )));
-    }
-    if options.max_sweeps == 0 {
+    if max_sweeps == 0 {
         return Err(GraphError::BadOption(
             "max_sweeps must be at least 1".into(),
         ));
     }
-    if options.root.is_some_and(|r| r >= n) {
+    if root.is_some_and(|r| r >= n) {
         return Err(GraphError::BadOption(format!(
             "root {} out of range ({n} shapes)",
-            options.root.unwrap_or(0)
+            root.unwrap_or(0)
         )));
     }
     for i in 0..n {
@@ -586,6 +598,110 @@ fn check(graph: &ShapeGraph, options: &CosegmentOptions) -> Result<(), GraphErro
         }
     }
     Ok(())
+}
+
+/// The state one extraction of tuples carries from the first tuple to the leftovers (of
+/// [`cosegment`] and of the adaptive extraction of `parts`): the spanning tree, the vertices of
+/// each shape not yet in a tuple, and the sampled triangles with their operators (built once).
+pub(crate) struct Extraction<'g> {
+    /// Root of the spanning tree.
+    pub(crate) root: usize,
+    /// Breadth-first order (root first).
+    pub(crate) order: Vec<usize>,
+    /// Spanning-tree parent of each shape.
+    pub(crate) parent: Vec<Option<usize>>,
+    /// The vertices of each shape in no tuple yet, ascending.
+    pub(crate) rem: Vec<Vec<u32>>,
+    triangles: Vec<[usize; 3]>,
+    tri_ops: TriangleOps<'g>,
+}
+
+impl<'g> Extraction<'g> {
+    /// Every vertex remaining, the spanning tree from `root` (or the best-connected shape) and
+    /// `triangles` sampled triangles.
+    pub(crate) fn start(
+        graph: &'g ShapeGraph,
+        root: Option<usize>,
+        triangles: usize,
+    ) -> Result<Self, GraphError> {
+        let (root, order, parent) = spanning_tree(graph, root);
+        let rem = (0..graph.node_count())
+            .map(|i| (0..graph.node(i).bands.vertices as u32).collect())
+            .collect();
+        let triangles = sample_triangles(graph, triangles);
+        let tri_ops = triangle_ops(graph, &triangles)?;
+        Ok(Self {
+            root,
+            order,
+            parent,
+            rem,
+            triangles,
+            tri_ops,
+        })
+    }
+
+    /// Tree-edge agreement and triangle cycle consistency of `tuple` on what remains (the
+    /// engine's histograms hold the tuple's regions); see [`confidence`].
+    pub(crate) fn confidence(
+        &self,
+        graph: &ShapeGraph,
+        eng: &mut Engine<'_>,
+        tuple: &[Vec<u32>],
+    ) -> (f64, Option<f64>) {
+        confidence(
+            graph,
+            eng,
+            &self.parent,
+            &self.tri_ops,
+            &self.triangles,
+            &self.rem,
+            tuple,
+        )
+    }
+
+    /// Takes `tuple`'s regions out of what remains.
+    pub(crate) fn take(&mut self, tuple: &[Vec<u32>]) {
+        for (i, region) in tuple.iter().enumerate() {
+            remove_sorted(&mut self.rem[i], region);
+        }
+    }
+
+    /// Appends the leftover tuple (every shape's remaining vertices, loaded into `eng`, with
+    /// its confidences) when a vertex remains or no tuple was extracted.
+    pub(crate) fn push_leftovers(
+        &self,
+        graph: &ShapeGraph,
+        eng: &mut Engine<'_>,
+        tuples: &mut Vec<RegionTuple>,
+    ) {
+        if self.rem.iter().any(|r| !r.is_empty()) || tuples.is_empty() {
+            let tuple = self.rem.clone();
+            for (i, region) in tuple.iter().enumerate() {
+                eng.set_region(i, region);
+            }
+            let (confidence, cyc) = self.confidence(graph, eng, &tuple);
+            tuples.push(leftovers_tuple(graph, tuple, confidence, cyc));
+        }
+    }
+
+    /// The co-segmentation of `tuples` extracted with area fraction `alpha`.
+    pub(crate) fn finish(
+        self,
+        graph: &ShapeGraph,
+        alpha: f64,
+        tuples: Vec<RegionTuple>,
+    ) -> Cosegmentation {
+        let n = graph.node_count();
+        Cosegmentation {
+            names: (0..n).map(|i| graph.node(i).name.clone()).collect(),
+            vertices: (0..n).map(|i| graph.node(i).bands.vertices).collect(),
+            root: self.root,
+            order: self.order,
+            parent: self.parent,
+            alpha,
+            tuples,
+        }
+    }
 }
 
 /// Root and breadth-first spanning tree of the graph.
@@ -666,18 +782,14 @@ pub(crate) fn seed_region(
 }
 
 /// The last tuple: the leftover vertices of every shape, with their confidences.
-pub(crate) fn leftovers_tuple(
+fn leftovers_tuple(
     graph: &ShapeGraph,
     regions: Vec<Vec<u32>>,
     confidence: f64,
     cycle_consistency: Option<f64>,
 ) -> RegionTuple {
     RegionTuple {
-        area_fractions: regions
-            .iter()
-            .enumerate()
-            .map(|(i, t)| area(&graph.node(i).areas, t))
-            .collect(),
+        area_fractions: area_fractions(graph, &regions),
         regions,
         sweeps: 0,
         converged: true,
@@ -687,6 +799,15 @@ pub(crate) fn leftovers_tuple(
         cycle_consistency,
         leftover: true,
     }
+}
+
+/// The area fraction of each shape's region of `tuple` (shapes have unit area).
+pub(crate) fn area_fractions(graph: &ShapeGraph, tuple: &[Vec<u32>]) -> Vec<f64> {
+    tuple
+        .iter()
+        .enumerate()
+        .map(|(i, t)| area(&graph.node(i).areas, t))
+        .collect()
 }
 
 pub(crate) fn area(areas: &[f64], v: &[u32]) -> f64 {
@@ -796,29 +917,22 @@ pub fn cosegment(
     options: &CosegmentOptions,
 ) -> Result<Cosegmentation, GraphError> {
     check(graph, options)?;
-    let n = graph.node_count();
     let alpha = options.alpha();
-    let (root, order, parent) = spanning_tree(graph, options.root);
+    let mut x = Extraction::start(graph, options.root, options.triangles)?;
     let mut eng = Engine::new(graph);
-    let mut rem: Vec<Vec<u32>> = (0..n)
-        .map(|i| (0..graph.node(i).bands.vertices as u32).collect())
-        .collect();
-    // Operators of the sampled triangles, built once.
-    let triangles = sample_triangles(graph, options.triangles);
-    let tri_ops = triangle_ops(graph, &triangles)?;
     let mut tuples = Vec::with_capacity(options.regions);
     let mut scratch = Scratch::default();
     for r in 0..options.regions.saturating_sub(1) {
-        if rem.iter().any(Vec::is_empty) {
+        if x.rem.iter().any(Vec::is_empty) {
             break;
         }
-        let seed = seed_region(graph, root, &rem[root], options.seed, r);
+        let seed = seed_region(graph, x.root, &x.rem[x.root], options.seed, r);
         let tree = Tree {
-            root,
-            order: &order,
-            parent: &parent,
+            root: x.root,
+            order: &x.order,
+            parent: &x.parent,
         };
-        let mut tuple = grow_tuple(&mut eng, &tree, seed, &rem, alpha, &mut scratch);
+        let mut tuple = grow_tuple(&mut eng, &tree, seed, &x.rem, alpha, &mut scratch);
         let SweepOutcome {
             sweeps,
             converged,
@@ -826,24 +940,17 @@ pub fn cosegment(
             objective,
         } = sweep_tuple(
             &mut eng,
-            &order,
-            &rem,
+            &x.order,
+            &x.rem,
             &mut tuple,
             alpha,
             options.max_sweeps,
             &mut scratch,
         );
-        let (confidence, cyc) =
-            confidence(graph, &mut eng, &parent, &tri_ops, &triangles, &rem, &tuple);
-        for (i, region) in tuple.iter().enumerate() {
-            remove_sorted(&mut rem[i], region);
-        }
+        let (confidence, cyc) = x.confidence(graph, &mut eng, &tuple);
+        x.take(&tuple);
         tuples.push(RegionTuple {
-            area_fractions: tuple
-                .iter()
-                .enumerate()
-                .map(|(i, t)| area(&graph.node(i).areas, t))
-                .collect(),
+            area_fractions: area_fractions(graph, &tuple),
             regions: tuple,
             sweeps,
             converged,
@@ -854,25 +961,8 @@ pub fn cosegment(
             leftover: false,
         });
     }
-    // The leftovers.
-    if rem.iter().any(|r| !r.is_empty()) || tuples.is_empty() {
-        let tuple = rem.clone();
-        for (i, region) in tuple.iter().enumerate() {
-            eng.set_region(i, region);
-        }
-        let (confidence, cyc) =
-            confidence(graph, &mut eng, &parent, &tri_ops, &triangles, &rem, &tuple);
-        tuples.push(leftovers_tuple(graph, tuple, confidence, cyc));
-    }
-    Ok(Cosegmentation {
-        names: (0..n).map(|i| graph.node(i).name.clone()).collect(),
-        vertices: (0..n).map(|i| graph.node(i).bands.vertices).collect(),
-        root,
-        order,
-        parent,
-        alpha,
-        tuples,
-    })
+    x.push_leftovers(graph, &mut eng, &mut tuples);
+    Ok(x.finish(graph, alpha, tuples))
 }
 
 /// The spanning tree a tuple grows along: its root, the visiting order (root first) and each

@@ -23,8 +23,7 @@ mod stable_cycle;
 
 pub use cosegment::{CosegmentOptions, Cosegmentation, RegionTuple, cosegment, cosegment_update};
 pub(crate) use cosegment::{
-    Engine, area, confidence, leftovers_tuple, sample_triangles, seed_region, spanning_tree,
-    triangle_ops, tuple_hash,
+    Engine, Extraction, area, area_fractions, check_extraction, seed_region, tuple_hash,
 };
 pub use cycle_consistency::{CycleConsistency, cycle_consistency};
 pub use load_collection::{

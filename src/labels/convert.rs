@@ -17,13 +17,7 @@ use std::collections::BTreeMap;
 /// assert_eq!(faces_to_vertices(&m, &[4]).unwrap(), vec![4, 4, 4, -1]); // vertex 3: in no face
 /// ```
 pub fn faces_to_vertices(mesh: &TriMesh, face_labels: &[i32]) -> Result<Vec<i32>, LabelError> {
-    if face_labels.len() != mesh.face_count() {
-        return Err(LabelError::Length {
-            what: "faces",
-            expected: mesh.face_count(),
-            got: face_labels.len(),
-        });
-    }
+    one_each("faces", mesh.face_count(), face_labels.len())?;
     let areas = mesh.face_areas();
     // (label, area, faces) per vertex; a vertex touches few faces, so a short list beats a map.
     let mut acc: Vec<Vec<(i32, f64, u32)>> = vec![Vec::new(); mesh.vertex_count()];
@@ -75,13 +69,7 @@ pub fn faces_to_vertices(mesh: &TriMesh, face_labels: &[i32]) -> Result<Vec<i32>
 /// assert_eq!(vertices_to_faces(&m, &[0, 1, 1, -1]).unwrap(), vec![1, 1]);
 /// ```
 pub fn vertices_to_faces(mesh: &TriMesh, vertex_labels: &[i32]) -> Result<Vec<i32>, LabelError> {
-    if vertex_labels.len() != mesh.vertex_count() {
-        return Err(LabelError::Length {
-            what: "vertices",
-            expected: mesh.vertex_count(),
-            got: vertex_labels.len(),
-        });
-    }
+    one_each("vertices", mesh.vertex_count(), vertex_labels.len())?;
     Ok(mesh
         .faces()
         .iter()
@@ -120,4 +108,17 @@ pub fn label_set<'a>(labels: impl IntoIterator<Item = &'a [i32]>) -> BTreeMap<i3
         }
     }
     out
+}
+
+/// Checks that there is one label per face or vertex (`what`): `got` labels for `expected`.
+fn one_each(what: &'static str, expected: usize, got: usize) -> Result<(), LabelError> {
+    if got == expected {
+        Ok(())
+    } else {
+        Err(LabelError::Length {
+            what,
+            expected,
+            got,
+        })
+    }
 }

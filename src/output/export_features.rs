@@ -70,13 +70,7 @@ pub fn export_features(
         written.push(path);
         Ok(())
     };
-    // Vertex-major copy of the feature-major values.
-    let mut rows = vec![0.0; d * n];
-    for f in 0..n {
-        for (v, &x) in descriptors.feature(f).iter().enumerate() {
-            rows[v * n + f] = x;
-        }
-    }
+    let rows = vertex_major(d, n, |f| descriptors.feature(f));
     match options.format {
         ExportFormat::Npy => {
             put("descriptors.npy", npy(&rows, &[d, n])?)?;
@@ -94,12 +88,7 @@ pub fn export_features(
     )?;
     if let Some(s) = spectrum {
         let (k, sd) = (s.len(), s.vertex_count());
-        let mut vecs = vec![0.0; sd * k];
-        for i in 0..k {
-            for (v, &x) in s.eigenvector(i).iter().enumerate() {
-                vecs[v * k + i] = x;
-            }
-        }
+        let vecs = vertex_major(sd, k, |i| s.eigenvector(i));
         match options.format {
             ExportFormat::Npy => {
                 put("eigenvalues.npy", npy(&s.eigenvalues, &[k])?)?;
@@ -193,4 +182,19 @@ fn csv<T: std::fmt::Display>(data: &[T], cols: usize, names: &[String]) -> Vec<u
 /// The family of an extra column from its name: `ext`, `sdf` or `user`.
 fn extra_family(name: &str) -> String {
     name.split(['_', ':']).next().unwrap_or(name).to_string()
+}
+
+/// The vertex-major copy (`vertices × columns`, row by row) of `columns` per-vertex columns.
+fn vertex_major<'a>(
+    vertices: usize,
+    columns: usize,
+    column: impl Fn(usize) -> &'a [f64],
+) -> Vec<f64> {
+    let mut rows = vec![0.0; vertices * columns];
+    for c in 0..columns {
+        for (v, &x) in column(c).iter().enumerate() {
+            rows[v * columns + c] = x;
+        }
+    }
+    rows
 }

@@ -14,6 +14,11 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 
 const TEMPLATE: &str = include_str!("viewer.html");
+/// The page's WebGL helpers (`shader`, `normals`), shared with the studio page of `coseg studio`.
+const GL_FUNCTIONS: &str = include_str!("gl_functions.js");
+/// The page's shaded program (`prog`) and its attribute and uniform locations (`loc`) for the
+/// context `gl`, shared with the studio page.
+const GL_PROGRAM: &str = include_str!("gl_program.js");
 
 fn base64(bytes: &[u8]) -> String {
     const ABC: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
@@ -125,7 +130,10 @@ pub fn write_viewer(
     let json = serde_json::to_string(&data)
         .map_err(|e| OutputError::Json(e.to_string()))?
         .replace("</", "<\\/");
-    let html = TEMPLATE.replace("__COSEG_DATA__", &json);
+    let html = TEMPLATE
+        .replace("__GL_FUNCTIONS__\n", GL_FUNCTIONS)
+        .replace("__GL_PROGRAM__\n", GL_PROGRAM)
+        .replace("__COSEG_DATA__", &json);
     std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
         path: dir.display().to_string(),
         source,

@@ -54,11 +54,10 @@
 //! tree is deterministic.
 
 use crate::graph::{
-    Cosegmentation, Engine, GraphError, RegionTuple, ShapeGraph, area, confidence, leftovers_tuple,
-    sample_triangles, seed_region, spanning_tree, triangle_ops, tuple_hash,
+    Cosegmentation, Engine, Extraction, GraphError, RegionTuple, ShapeGraph, area, area_fractions,
+    check_extraction, seed_region, tuple_hash,
 };
 use crate::stable::{Threshold, ThresholdScratch, threshold};
-use crate::vertex_sets::remove_sorted;
 use serde::{Deserialize, Serialize};
 
 /// Options of [`adaptive_cosegment`].
@@ -598,17 +597,7 @@ pub fn adaptive_update(
 }
 
 fn check(graph: &ShapeGraph, o: &AdaptiveOptions) -> Result<(), GraphError> {
-    let n = graph.node_count();
-    if n < 2 {
-        return Err(GraphError::BadOption(format!(
-            "co-segmentation needs at least 2 shapes, got {n}"
-        )));
-    }
-    if !graph.is_connected() {
-        return Err(GraphError::BadOption(
-            "the shape graph is not connected".into(),
-        ));
-    }
+    check_extraction(graph, o.root, o.max_sweeps)?;
     if o.max_parts == 0 || o.parts == Some(0) {
         return Err(GraphError::BadOption("parts must be at least 1".into()));
     }
@@ -623,25 +612,6 @@ fn check(graph: &ShapeGraph, o: &AdaptiveOptions) -> Result<(), GraphError> {
             "size_tolerance = {} must be finite and non-negative",
             o.size_tolerance
         )));
-    }
-    if o.max_sweeps == 0 {
-        return Err(GraphError::BadOption(
-            "max_sweeps must be at least 1".into(),
-        ));
-    }
-    if o.root.is_some_and(|r| r >= n) {
-        return Err(GraphError::BadOption(format!(
-            "root {} out of range ({n} shapes)",
-            o.root.unwrap_or(0)
-        )));
-    }
-    for i in 0..n {
-        if graph.node(i).bands.vertices == 0 {
-            return Err(GraphError::Incompatible {
-                name: graph.node(i).name.clone(),
-                reason: "no vertices".into(),
-            });
-        }
     }
     Ok(())
 }
@@ -732,19 +702,15 @@ pub fn adaptive_cosegment(
     check(graph, options)?;
     let o = options;
     let n = graph.node_count();
-    let (root, order, parent) = spanning_tree(graph, o.root);
-    let mut sw = Sweeper::new(graph, order.clone(), o.max_sweeps);
-    let mut rem: Vec<Vec<u32>> = (0..n)
-        .map(|i| (0..graph.node(i).bands.vertices as u32).collect())
-        .collect();
-    let triangles = sample_triangles(graph, o.triangles);
-    let tri_ops = triangle_ops(graph, &triangles)?;
+    let mut x = Extraction::start(graph, o.root, o.triangles)?;
+    let mut sw = Sweeper::new(graph, x.order.clone(), o.max_sweeps);
     let forced = o.parts.unwrap_or(0).min(o.max_parts).saturating_sub(1);
     let mut tuples = Vec::new();
     let mut auto = Vec::new();
     let mut stop = StopReason::MaxParts;
     while tuples.len() + 1 < o.max_parts {
         let enforce = tuples.len() >= forced;
+        let rem = &x.rem;
         let left = median(
             &(0..n)
                 .map(|i| area(&graph.node(i).areas, &rem[i]))
@@ -754,31 +720,21 @@ pub fn adaptive_cosegment(
             stop = StopReason::Exhausted;
             break;
         }
-        let seed = seed_region(graph, root, &rem[root], o.seed, tuples.len());
-        let start = sw.spread(&rem, seed, &parent, Threshold::MeanStd(0.0));
+        let seed = seed_region(graph, x.root, &rem[x.root], o.seed, tuples.len());
+        let start = sw.spread(rem, seed, &x.parent, Threshold::MeanStd(0.0));
         let mut probes = 0;
-        let Some((step, omega)) = search_threshold(&mut sw, &rem, start, o, &mut probes) else {
+        let Some((step, omega)) = search_threshold(&mut sw, rem, start, o, &mut probes) else {
             stop = StopReason::NoStableTuple;
             break;
         };
-        let (tuple, alphas, settled) = area_matched(&mut sw, &rem, omega, o);
+        let (tuple, alphas, settled) = area_matched(&mut sw, rem, omega, o);
         if tuple.iter().any(Vec::is_empty) {
             stop = StopReason::NoStableTuple;
             break;
         }
         sw.load(&tuple);
-        let (conf, cyc) = confidence(
-            graph,
-            &mut sw.eng,
-            &parent,
-            &tri_ops,
-            &triangles,
-            &rem,
-            &tuple,
-        );
-        let fractions: Vec<f64> = (0..n)
-            .map(|i| area(&graph.node(i).areas, &tuple[i]))
-            .collect();
+        let (conf, cyc) = x.confidence(graph, &mut sw.eng, &tuple);
+        let fractions = area_fractions(graph, &tuple);
         let separation = median(
             &(0..n)
                 .map(|i| separation(&mut sw, i, &rem[i], &tuple[i]))
@@ -790,9 +746,7 @@ pub fn adaptive_cosegment(
                 break;
             }
         }
-        for (i, region) in tuple.iter().enumerate() {
-            remove_sorted(&mut rem[i], region);
-        }
+        x.take(&tuple);
         auto.push(AutoTuple {
             t: step as f64 * o.delta_t,
             alphas,
@@ -811,21 +765,9 @@ pub fn adaptive_cosegment(
             leftover: false,
         });
     }
-    if rem.iter().any(|r| !r.is_empty()) || tuples.is_empty() {
-        tuples.push(leftover_tuple(
-            graph, &mut sw, &parent, &tri_ops, &triangles, &rem,
-        ));
-    }
+    x.push_leftovers(graph, &mut sw.eng, &mut tuples);
     let alpha = mean_alpha(&tuples, auto.len(), n);
-    let leaves = Cosegmentation {
-        names: (0..n).map(|i| graph.node(i).name.clone()).collect(),
-        vertices: (0..n).map(|i| graph.node(i).bands.vertices).collect(),
-        root,
-        order,
-        parent,
-        alpha,
-        tuples,
-    };
+    let leaves = x.finish(graph, alpha, tuples);
     let tree = part_tree(&mut sw, &leaves, &[]);
     Ok(AdaptiveCosegmentation {
         leaves,
@@ -835,25 +777,6 @@ pub fn adaptive_cosegment(
         leaf_origin: Vec::new(),
         leaf_copies: Vec::new(),
     })
-}
-
-/// The leftover tuple: every shape's remaining vertices, with its confidence and cycle
-/// consistency (loads it into the sweeper's engine).
-fn leftover_tuple(
-    graph: &ShapeGraph,
-    sw: &mut Sweeper<'_>,
-    parent: &[Option<usize>],
-    tri_ops: &[Vec<(
-        crate::affinity::BandAffinity<'_>,
-        crate::affinity::Direction,
-    )>],
-    triangles: &[[usize; 3]],
-    rem: &[Vec<u32>],
-) -> RegionTuple {
-    let tuple = rem.to_vec();
-    sw.load(&tuple);
-    let (conf, cyc) = confidence(graph, &mut sw.eng, parent, tri_ops, triangles, rem, &tuple);
-    leftovers_tuple(graph, tuple, conf, cyc)
 }
 
 /// The mean over the `parts` extracted (non-leftover) tuples of their mean area fraction over

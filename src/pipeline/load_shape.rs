@@ -26,6 +26,20 @@ pub struct CacheResult {
     pub write_error: Option<String>,
 }
 
+impl CacheResult {
+    /// Its warnings for the user: why the entry was recomputed, that it could not be written.
+    fn warnings(&self) -> Vec<String> {
+        let recomputed = match &self.outcome {
+            CacheOutcome::Recomputed { reason } => Some(reason.clone()),
+            _ => None,
+        };
+        recomputed
+            .into_iter()
+            .chain(self.write_error.clone())
+            .collect()
+    }
+}
+
 /// The result of [`load_or_compute_bands`].
 #[derive(Debug, Clone)]
 pub struct BandsResult {
@@ -151,10 +165,7 @@ pub fn load_or_compute_bands(
         }
     }
     let full = load_or_compute(mesh, options, cache_dir)?;
-    if let CacheOutcome::Recomputed { reason } = &full.outcome {
-        warnings.push(reason.clone());
-    }
-    warnings.extend(full.write_error);
+    warnings.extend(full.warnings());
     let data = ShapeBands::of(&full.data);
     if let Err(e) = write_entry(&path, &encode_bands_entry(&data)) {
         warnings.push(format!("{}: cache entry not written: {e}", path.display()));
@@ -188,11 +199,7 @@ impl ShapeContent for ShapeData {
             return Ok((compute_shape_data(mesh, options)?, None, Vec::new()));
         };
         let r = load_or_compute(mesh, options, dir)?;
-        let mut warnings = Vec::new();
-        if let CacheOutcome::Recomputed { reason } = &r.outcome {
-            warnings.push(reason.clone());
-        }
-        warnings.extend(r.write_error);
+        let warnings = r.warnings();
         Ok((r.data, Some(r.outcome), warnings))
     }
 }

@@ -516,19 +516,29 @@ impl Studio {
 
     /// Undoes the last edit; returns the shape it changed (`None`: nothing to undo).
     pub fn undo(&mut self) -> Option<usize> {
-        let edit = self.undo.pop()?;
-        self.set(&edit, true);
-        let i = edit.shape;
-        self.redo.push(edit);
-        Some(i)
+        self.replay(true)
     }
 
     /// Redoes the last undone edit; returns the shape it changed (`None`: nothing to redo).
     pub fn redo(&mut self) -> Option<usize> {
-        let edit = self.redo.pop()?;
-        self.set(&edit, false);
+        self.replay(false)
+    }
+
+    /// Moves the last edit of the undo stack (`back`) or of the redo stack onto the other one,
+    /// setting the shape to the state before it or after it; returns the shape.
+    fn replay(&mut self, back: bool) -> Option<usize> {
+        let edit = if back {
+            self.undo.pop()
+        } else {
+            self.redo.pop()
+        }?;
+        self.set(&edit, back);
         let i = edit.shape;
-        self.undo.push(edit);
+        if back {
+            self.redo.push(edit);
+        } else {
+            self.undo.push(edit);
+        }
         Some(i)
     }
 

@@ -111,3 +111,25 @@ pub fn spectrum_of(mesh: &coseg::mesh::TriMesh, k: usize) -> coseg::spectral::Sp
     )
     .unwrap()
 }
+
+/// A labelled blob and two vertex-permuted copies of it (exact isometries), for propagation:
+/// `dir/shapes/` holds `a.off` (`blob(3)`), `c1.off` and `c2.off` (permutation seeds 11 and
+/// 12); `dir/a.labels.txt` holds `truth` of the blob. Returns the folder, the blob and the
+/// copies.
+pub fn labelled_blob_and_copies(
+    dir: &std::path::Path,
+    truth: impl Fn(&TriMesh) -> Vec<i32>,
+) -> (std::path::PathBuf, TriMesh, Vec<TriMesh>) {
+    let shapes = dir.join("shapes");
+    std::fs::create_dir(&shapes).unwrap();
+    let mesh = blob(3);
+    coseg::mesh::write_mesh(shapes.join("a.off"), &mesh, &[]).unwrap();
+    coseg::labels::write_vertex_labels(dir, "a", &truth(&mesh)).unwrap();
+    let mut copies = Vec::new();
+    for (k, seed) in [(1, 11u64), (2, 12)] {
+        let copy = permute_mesh(&mesh, &permutation(mesh.vertex_count(), seed));
+        coseg::mesh::write_mesh(shapes.join(format!("c{k}.off")), &copy, &[]).unwrap();
+        copies.push(copy);
+    }
+    (shapes, mesh, copies)
+}

@@ -1,7 +1,7 @@
 //! Fixtures for the shape-graph tests: structured band tables and vertex permutations.
 
 use coseg::bands::{BandTable, equal_count_bands};
-use coseg::graph::{Cosegmentation, RegionTuple};
+use coseg::graph::{Cosegmentation, RegionTuple, ShapeNode};
 use coseg::mesh::TriMesh;
 use coseg::parts::PartCues;
 use rand_chacha::ChaCha8Rng;
@@ -101,6 +101,23 @@ pub fn uniform_cues(meshes: &[TriMesh]) -> Vec<PartCues> {
         .map(|m| PartCues {
             thickness: vec![1.0; m.vertex_count()],
             mean_curvature: vec![1.0; m.vertex_count()],
+        })
+        .collect()
+}
+
+/// The shape graph's nodes of `meshes` through the per-shape pipeline `options`, named
+/// `{prefix}0`, `{prefix}1`, …
+pub fn shape_nodes(
+    meshes: &[TriMesh],
+    options: &coseg::pipeline::ShapePipelineOptions,
+    prefix: &str,
+) -> Vec<ShapeNode> {
+    meshes
+        .iter()
+        .enumerate()
+        .map(|(i, m)| {
+            let d = coseg::pipeline::compute_shape_data(m, options).unwrap();
+            ShapeNode::new(format!("{prefix}{i}"), d.bands, &d.descriptors.vertex_areas).unwrap()
         })
         .collect()
 }

@@ -12,7 +12,7 @@
 //! Ignored: texture coordinates, normals, lines, points, groups, materials, smoothing and any
 //! other statement.
 
-use super::text::{TokenLines, coordinate, short};
+use super::text::{TokenLines, position, short};
 use super::{RawMesh, fan, out_of_range, parse_error};
 use crate::mesh::{MeshError, TriMesh};
 use std::io::Write;
@@ -56,17 +56,7 @@ pub(super) fn parse(bytes: &[u8]) -> Result<RawMesh, MeshError> {
         match kw {
             "v" => {
                 let t: Vec<&str> = toks.take(3).collect();
-                if t.len() < 3 {
-                    return Err(parse_error(
-                        Some(line),
-                        format!("vertex has {} coordinates, expected 3", t.len()),
-                    ));
-                }
-                positions.push([
-                    coordinate(t[0], line)?,
-                    coordinate(t[1], line)?,
-                    coordinate(t[2], line)?,
-                ]);
+                positions.push(position(&t, line, None)?);
             }
             "f" | "fo" => {
                 polys.push(read_face(toks, line, positions.len())?);

@@ -9,7 +9,7 @@
 //! warning ([`MeshWarning::IgnoredData`]). Rejected: the `4OFF`/`nOFF` dimension prefixes and
 //! `OFF BINARY`, records fewer than the header declares (truncated file).
 
-use super::text::{TokenLines, coordinate, short};
+use super::text::{TokenLines, position, short};
 use super::{RawMesh, capacity_hint, fan, header_error, out_of_range, parse_error, truncated};
 use crate::mesh::{MeshError, MeshWarning, TriMesh};
 use std::io::Write;
@@ -107,17 +107,7 @@ fn read_vertices(
                 lines.line()
             )));
         };
-        if t.len() < 3 {
-            return Err(parse_error(
-                Some(l),
-                format!("vertex {i} has {} coordinates, expected 3", t.len()),
-            ));
-        }
-        positions.push([
-            coordinate(t[0], l)?,
-            coordinate(t[1], l)?,
-            coordinate(t[2], l)?,
-        ]);
+        positions.push(position(&t, l, Some(i))?);
     }
     Ok(positions)
 }

@@ -59,10 +59,31 @@ impl<'a> TokenLines<'a> {
 
 /// Parses a coordinate. Accepts what Rust's `f64` parser accepts (including `nan`/`inf`, which
 /// validation later rejects with a [`MeshError::NonFinite`] naming the vertex).
-pub(crate) fn coordinate(token: &str, line: usize) -> Result<f64, MeshError> {
+fn coordinate(token: &str, line: usize) -> Result<f64, MeshError> {
     token
         .parse::<f64>()
         .map_err(|_| parse_error(Some(line), format!("invalid coordinate `{}`", short(token))))
+}
+
+/// The position of a vertex line's first three tokens `t` (line `line`); `index`, the vertex's
+/// number where the format counts vertices, names it in the error of a short line.
+pub(crate) fn position(
+    t: &[&str],
+    line: usize,
+    index: Option<usize>,
+) -> Result<[f64; 3], MeshError> {
+    if t.len() < 3 {
+        let vertex = index.map_or("vertex".to_string(), |i| format!("vertex {i}"));
+        return Err(parse_error(
+            Some(line),
+            format!("{vertex} has {} coordinates, expected 3", t.len()),
+        ));
+    }
+    Ok([
+        coordinate(t[0], line)?,
+        coordinate(t[1], line)?,
+        coordinate(t[2], line)?,
+    ])
 }
 
 /// At most 40 characters of `token`, for error messages.
