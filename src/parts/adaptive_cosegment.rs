@@ -617,7 +617,7 @@ fn check(graph: &ShapeGraph, o: &AdaptiveOptions) -> Result<(), GraphError> {
 }
 
 /// The median of `v` (the mean of the middle two for an even length).
-pub(super) fn median(v: &[f64]) -> f64 {
+pub(crate) fn median(v: &[f64]) -> f64 {
     let mut s = v.to_vec();
     s.sort_by(f64::total_cmp);
     let m = s.len() / 2;

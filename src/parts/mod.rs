@@ -32,6 +32,9 @@ mod snap_part_boundaries;
 mod split_disconnected_leaves;
 mod start_score;
 
+// The median of a list (the mean of the middle two for an even length), for every stage that
+// takes one over shapes or votes.
+pub(crate) use adaptive_cosegment::median;
 pub use adaptive_cosegment::{
     AdaptiveCosegmentation, AdaptiveOptions, AutoTuple, PartMerge, PartTree, Sizing, StopReason,
     adaptive_cosegment, adaptive_update,

@@ -704,19 +704,6 @@ fn pair_collapse(
         .map(|(x, y)| (y, x, z))
 }
 
-/// The median of `values` (the mean of the middle two for an even count); `None` when empty.
-fn median(mut values: Vec<f64>) -> Option<f64> {
-    if values.is_empty() {
-        return None;
-    }
-    values.sort_by(f64::total_cmp);
-    let k = values.len();
-    Some(match k % 2 {
-        1 => values[k / 2],
-        _ => (values[k / 2 - 1] + values[k / 2]) / 2.0,
-    })
-}
-
 /// Per shape, the vote weights (voting positions) where a member of the shared pair collapsed
 /// with its partner ([`pair_collapse`]); `None` on the other shapes, which keep the
 /// shared-failure vote.
@@ -770,7 +757,8 @@ fn collapse_weights(
     }
     let level: BTreeMap<usize, f64> = levels
         .into_iter()
-        .filter_map(|(r, v)| Some((r, median(v)?)))
+        .filter(|(_, v)| !v.is_empty())
+        .map(|(r, v)| (r, crate::parts::median(&v)))
         .collect();
     for (i, c) in collapsed.into_iter().enumerate() {
         let (Some((y, x, z)), Some((voting, classes, _))) = (c, &shapes[i]) else {
