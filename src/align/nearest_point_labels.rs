@@ -32,7 +32,13 @@ pub fn nearest_point_labels(
     target: &TriMesh,
     transform: &Similarity,
 ) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
-    one_each("face", source.face_count(), source_face_labels.len())?;
+    if source_face_labels.len() != source.face_count() {
+        return Err(AlignError::LabelCount {
+            expected: source.face_count(),
+            found: source_face_labels.len(),
+            kind: "face",
+        });
+    }
     let index = SurfaceIndex::new(source);
     Ok(nearest(&index, target, transform, |c| {
         source_face_labels[c.face]
@@ -71,7 +77,13 @@ pub(crate) fn nearest_point_vertex_labels_in(
     target: &TriMesh,
     transform: &Similarity,
 ) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
-    one_each("vertex", source.vertex_count(), source_vertex_labels.len())?;
+    if source_vertex_labels.len() != source.vertex_count() {
+        return Err(AlignError::LabelCount {
+            expected: source.vertex_count(),
+            found: source_vertex_labels.len(),
+            kind: "vertex",
+        });
+    }
     let faces = source.faces();
     Ok(nearest(index, target, transform, |c| {
         let mut k = 0;
@@ -82,19 +94,6 @@ pub(crate) fn nearest_point_vertex_labels_in(
         }
         source_vertex_labels[faces[c.face][k] as usize]
     }))
-}
-
-/// Checks that there is one source label per face or vertex (`kind`).
-fn one_each(kind: &'static str, expected: usize, found: usize) -> Result<(), AlignError> {
-    if found == expected {
-        Ok(())
-    } else {
-        Err(AlignError::LabelCount {
-            expected,
-            found,
-            kind,
-        })
-    }
 }
 
 /// Per target vertex (moved by `transform`), the label `label` reads off the closest point
