@@ -46,7 +46,7 @@ use std::path::{Path, PathBuf};
 
 /// Version of the cache file format and of the computations it stores. Bump it whenever the
 /// layout or any algorithm's output changes: older files then read as stale and are recomputed.
-pub const FORMAT_VERSION: u32 = 5;
+pub const FORMAT_VERSION: u32 = 6;
 
 const HEADER_LEN: usize = 8 + 4 + 32 + 8 + 32;
 /// File extension of full entries ([`EntryKind::Full`]).

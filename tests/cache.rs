@@ -535,7 +535,7 @@ fn the_bands_entry_is_compressed() {
 fn entries_of_another_format_version_are_stale_and_recomputed() {
     use coseg::cache::{FORMAT_VERSION, bands_path};
     use coseg::pipeline::load_or_compute_bands;
-    assert_eq!(FORMAT_VERSION, 5);
+    assert_eq!(FORMAT_VERSION, 6);
     let dir = tempfile::tempdir().unwrap();
     let (m, o) = (mesh(), opts());
     let first = load_or_compute_bands(&m, &o, dir.path()).unwrap().data;
@@ -545,14 +545,14 @@ fn entries_of_another_format_version_are_stale_and_recomputed() {
         std::fs::read(&full).unwrap(),
         std::fs::read(&compact).unwrap(),
     ];
-    for version in [3u32, 4, 6] {
+    for version in [3u32, 4, 5] {
         for (path, bytes) in [(&full, &good[0]), (&compact, &good[1])] {
             let mut old = bytes.clone();
             old[8..12].copy_from_slice(&version.to_le_bytes());
             std::fs::write(path, &old).unwrap();
         }
         let r = load_or_compute_bands(&m, &o, dir.path()).unwrap();
-        let needle = format!("stale format version {version} (current 5)");
+        let needle = format!("stale format version {version} (current {FORMAT_VERSION})");
         assert_eq!(
             r.outcome,
             CacheOutcome::Recomputed {

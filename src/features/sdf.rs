@@ -89,6 +89,33 @@ fn basis(n: &Vector3<f64>) -> (Vector3<f64>, Vector3<f64>) {
     )
 }
 
+/// The cone's tangent frame `(t, b)` at a vertex at `p` with unit inner normal `inner`: `t`
+/// along the edge to `neighbour` projected onto the tangent plane, `b = inner × t`; so the
+/// rays turn with the mesh and a moved mesh casts the same rays (up to rounding). Without a
+/// neighbour, or with an edge within `EDGE_ALONG_NORMAL` of the normal, [`basis`] (a
+/// function of the normal alone).
+fn cone_frame(
+    inner: &Vector3<f64>,
+    p: &[f64; 3],
+    neighbour: Option<&[f64; 3]>,
+) -> (Vector3<f64>, Vector3<f64>) {
+    if let Some(q) = neighbour {
+        let e = Vector3::new(q[0] - p[0], q[1] - p[1], q[2] - p[2]);
+        let t = e - inner * inner.dot(&e);
+        let (tn, en) = (t.norm(), e.norm());
+        if en > 0.0 && tn > EDGE_ALONG_NORMAL * en {
+            let t = t / tn;
+            return (t, inner.cross(&t));
+        }
+    }
+    basis(inner)
+}
+
+/// An edge whose part in the tangent plane is shorter than this share of its length runs
+/// along the normal (a needle, a degenerate ring): its direction in the tangent plane is
+/// rounding, so the cone falls back to [`basis`]. A numerical guard, not a tuned level.
+const EDGE_ALONG_NORMAL: f64 = 1e-6;
+
 /// Per vertex: does its connected component enclose a negative signed volume (faces wound
 /// inwards)? Such components get their normals flipped so that every normal points outwards.
 pub(crate) fn inward_wound(mesh: &TriMesh) -> Vec<bool> {
@@ -121,8 +148,9 @@ pub(crate) fn inward_wound(mesh: &TriMesh) -> Vec<bool> {
 ///
 /// Collection-consistent scale: lengths are divided by `√(total area)`, so the SDF of every
 /// shape is that of the shape scaled to unit area. Invariant to rigid motions and uniform
-/// scaling up to the cone's orientation about the normal (a function of the normal alone) and
-/// floating-point rounding; a vertex permutation permutes the values.
+/// scaling up to floating-point rounding: each cone is turned about the normal by the
+/// vertex's first edge, so it moves with the mesh. A vertex permutation may change the values
+/// by the cones' sampling (each vertex's first edge may change).
 ///
 /// Cost: one BVH (from the `bvh` crate) over the triangles, then `d × rays` ray casts in
 /// parallel (rayon, one task per vertex, so the result does not depend on the thread count).
@@ -203,16 +231,28 @@ fn raw_sdf(mesh: &TriMesh, rays: usize, half: f64) -> Vec<f64> {
     let diag = bbox_diagonal(mesh);
     let eps = 1e-9 * diag;
     let cone = cone_directions(rays, half);
-    let values: Vec<Option<f64>> = mesh
-        .positions()
+    let positions = mesh.positions();
+    // Each vertex's cone turns with the mesh: its first direction points along the vertex's
+    // first edge (its first face's next corner), not along a file axis.
+    let mut first_neighbour: Vec<Option<usize>> = vec![None; mesh.vertex_count()];
+    for f in mesh.faces() {
+        for k in 0..3 {
+            let v = f[k] as usize;
+            if first_neighbour[v].is_none() {
+                first_neighbour[v] = Some(f[(k + 1) % 3] as usize);
+            }
+        }
+    }
+    let values: Vec<Option<f64>> = positions
         .par_iter()
         .zip(normals.par_iter())
-        .map(|(p, n)| {
+        .enumerate()
+        .map(|(v, (p, n))| {
             let inner = -Vector3::new(n[0], n[1], n[2]);
             if inner.norm_squared() < 0.5 {
                 return None;
             }
-            let (t, b) = basis(&inner);
+            let (t, b) = cone_frame(&inner, p, first_neighbour[v].map(|u| &positions[u]));
             let origin = Point3::new(p[0], p[1], p[2]);
             let mut hits: Vec<f64> = cone
                 .iter()
