@@ -345,12 +345,25 @@ pub(crate) fn cohen_kappa(x: &[i32], y: &[i32], areas: &[f64]) -> f64 {
         .iter()
         .map(|(l, s)| s * sy.get(l).copied().unwrap_or(0.0))
         .sum();
-    if chance < 1.0 {
+    // `agree` and `chance` are sums of up to `d` area shares: rounding leaves each uncertain
+    // by up to `d ε` (ε the machine epsilon; the bound of a plain sum, doubled for the
+    // products of `chance`). Within that they are equal and κ is exactly 0 — as it is, in exact
+    // arithmetic, against a labelling with one label everywhere. Otherwise the sign of a
+    // κ that is 0 was rounding, and the tests that compare κ (the rigid route's outlier test,
+    // the triangle estimate that divides by it) followed it (docs/ALIGN.md, "Invariance").
+    let resolution = KAPPA_ROUNDING * x.len().max(1) as f64 * f64::EPSILON;
+    if chance < 1.0 && (agree - chance).abs() > resolution {
         (agree - chance) / (1.0 - chance)
     } else {
         0.0
     }
 }
+
+/// Multiple of `d ε` that bounds the rounding of κ's numerator over `d` vertices: one plain
+/// sum for the agreement (`d ε`), two for the label shares whose products make the chance
+/// agreement (`2 d ε`), and one more for their differences. A numerical bound, not a level
+/// fitted to data.
+const KAPPA_ROUNDING: f64 = 4.0;
 
 /// Each voting route's accuracy above chance `κ_r` from the pairwise κ (see
 /// [`fuse_routes`]), clamped to `[0, MAX_KAPPA]`; empty for fewer than three routes (no
