@@ -853,3 +853,44 @@ fn a_route_with_one_label_is_no_evidence_whatever_way_rounding_tips_kappa() {
         );
     }
 }
+
+#[test]
+fn the_parts_route_reads_the_parts_coseg_segment_chooses_not_one_part_per_label() {
+    // Regression (COSEG chairs, one source: the parts route 56–78 % where the bare `coseg
+    // segment` is right on 90 %): the parts route made its own co-segmentation cut at the
+    // number of source labels. It now reads the bare co-segmentation (the families, the frame
+    // and the number of parts chosen from the data), and cuts the same part tree finer only
+    // when the sources have more labels than the data's cut has parts.
+    use coseg::jobs::SegmentJob;
+    use coseg::parts::segment_collection;
+    use coseg::propagate::CollectionParts;
+    let dir = tempfile::tempdir().unwrap();
+    let (o, loaded, _) = four_goblets_loaded(dir.path());
+    let (nodes, meshes) = (loaded.nodes, loaded.meshes);
+    let mut job = SegmentJob::default();
+    job.pipeline = o.pipeline.clone();
+    job.graph = o.graph;
+    let bare = job
+        .collection_options(nodes[0].bands.features, o.cache_dir.clone())
+        .unwrap();
+    let segmented = segment_collection(nodes.clone(), &meshes, &bare).unwrap();
+    let chosen = segmented.part_count.as_ref().expect("the data chose").count;
+    let mut cp = CollectionParts::new(nodes, &o.pipeline, &o.graph, o.cache_dir.clone());
+    assert_eq!(
+        cp.data_parts(&meshes, None).unwrap(),
+        &segmented.segmentation
+    );
+    // Two labels, or as many as the data's parts: the data's parts as they are.
+    assert_eq!(cp.parts(2, &meshes).unwrap(), &segmented.segmentation);
+    assert_eq!(cp.parts(chosen, &meshes).unwrap(), &segmented.segmentation);
+    // More labels than parts: the same tree cut finer, at least one part per label.
+    let finer = cp.parts(chosen + 1, &meshes).unwrap().clone();
+    assert_eq!(segmented.segmentation.tuples.len(), chosen);
+    assert_eq!(finer.tuples.len(), chosen + 1);
+    let tree = segmented.adaptive.as_ref().expect("parts from geometry");
+    let coseg::parts::PartsFrom::Geometry { band, .. } = bare.parts_from else {
+        panic!("the bare parts come from geometry")
+    };
+    let cut = coseg::parts::snap_part_boundaries(&meshes, &tree.cut(chosen + 1), band).unwrap();
+    assert_eq!(finer, cut);
+}

@@ -52,7 +52,7 @@ pub use segment_collection::{
     FeatureSelection, PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentTimes,
     SegmentedCollection, segment_collection,
 };
-pub(crate) use segment_collection::{GEOMETRY_BAND, GEOMETRY_LEAVES, segment_collection_sharing};
+pub(crate) use segment_collection::{GEOMETRY_LEAVES, segment_collection_sharing};
 pub use snap_part_boundaries::snap_part_boundaries;
 pub use split_disconnected_leaves::{SplitLeaves, split_disconnected_leaves};
 pub use start_score::start_score;

@@ -9,7 +9,8 @@ use super::{
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
 use crate::parts::{
-    FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions, segment_collection_sharing,
+    AdaptiveCosegmentation, FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions,
+    StopReason, segment_collection_sharing, snap_part_boundaries,
 };
 use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
@@ -22,10 +23,11 @@ use std::path::PathBuf;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[non_exhaustive]
 pub struct RouteOptions {
-    /// The parts route ([`super::parts_route`]): the collection's co-segmentation as `coseg
-    /// segment --parts K --parts-from geometry` makes it, `K` the number of distinct labels
-    /// on the sources, each part named from the sources. Default `true`; `false` leaves the
-    /// affinity (and the other routes) alone.
+    /// The parts route ([`super::parts_route`]): the collection's co-segmentation as the bare
+    /// `coseg segment` makes it ([`CollectionParts`]: families and number of parts chosen from
+    /// the data; its part tree cut finer when the sources have more labels than it has
+    /// parts), each part named from the sources. Default `true`; `false` leaves the affinity
+    /// (and the other routes) alone.
     pub parts: bool,
     /// The rigid route ([`super::rigid_route`]): each unlabelled shape registered onto the
     /// sources by a similarity, labels from the nearest surface point. Default `true`.
@@ -76,25 +78,47 @@ impl RouteOptions {
     }
 }
 
-/// The collection's co-segmentations for the parts route, made once per number of parts and
-/// kept (a new annotation with the same number of labels reuses them).
+/// The collection's co-segmentation for the parts route: the parts `coseg segment FOLDER`
+/// makes with no flag (the feature families chosen from the data, the part tree of parts from
+/// geometry cut where the data says), made once and kept; when the sources have more labels
+/// than the data's cut has parts, the same part tree is cut finer, at the number of labels
+/// (naming merges parts that carry the same label, so a finer cut loses nothing, while a
+/// coarser one would have to give two labels one part).
 #[derive(Debug, Clone)]
 pub struct CollectionParts {
     nodes: Vec<ShapeNode>,
+    /// `coseg segment`'s bare options under the propagation's pipeline and graph.
     options: SegmentCollectionOptions,
     /// Whether the per-shape pipeline holds the intrinsic family alone (no extrinsic, SDF or
     /// user columns): what the parts read when their families are taken as given.
     intrinsic_pipeline: bool,
-    /// Per number of parts: the co-segmentation and whether it read the intrinsic family
-    /// alone.
+    /// The bare co-segmentation, once made.
+    data: Option<DataParts>,
+    /// Per number of labels: the co-segmentation the parts route reads and whether it read
+    /// the intrinsic family alone.
     made: BTreeMap<usize, (Cosegmentation, bool)>,
+}
+
+/// What [`CollectionParts`] keeps of the bare co-segmentation: its parts, its part tree (to
+/// cut finer) and what it read.
+#[derive(Debug, Clone)]
+struct DataParts {
+    /// The data's own cut.
+    segmentation: Cosegmentation,
+    /// The part tree over the equal-area leaves (parts from geometry).
+    tree: Option<AdaptiveCosegmentation>,
+    /// Whether the parts read the intrinsic family alone.
+    intrinsic: bool,
 }
 
 impl CollectionParts {
     /// The parts of the shapes `nodes` (graph order) under the per-shape `pipeline` they were
-    /// computed with (its feature weights, up direction and mirror-invariant columns, as
-    /// `coseg segment` uses them) and the shape `graph`'s options; `cue_cache`: where each
-    /// shape's part cues are kept (`None`: computed every run).
+    /// computed with and the shape `graph`'s options, made as `coseg segment` makes them:
+    /// with the intrinsic family alone in the pipeline the families are chosen from the data
+    /// (as `coseg segment` without `--features`), otherwise the pipeline's families are taken
+    /// as given (its weights, up direction and mirror-invariant columns, as `coseg segment
+    /// --features …`); `cue_cache`: where each shape's part cues are kept (`None`: computed
+    /// every run).
     pub fn new(
         nodes: Vec<ShapeNode>,
         pipeline: &ShapePipelineOptions,
@@ -102,25 +126,29 @@ impl CollectionParts {
         cue_cache: Option<PathBuf>,
     ) -> Self {
         let features = nodes.first().map_or(0, |n| n.bands.features);
-        let options = SegmentCollectionOptions {
-            graph: *graph,
-            feature_weights: pipeline.feature_weights(features),
-            up: pipeline.up_direction(),
-            mirror_columns: pipeline.mirror_invariant_columns(features),
-            cue_cache,
-            ..Default::default()
-        };
         let f = &pipeline.families;
+        let intrinsic_pipeline = f.extrinsic.is_none() && f.sdf.is_none() && f.user.is_none();
+        // `coseg segment`'s bare options (`SegmentJob::collection_options` with no mode flag):
+        // parts from geometry, their number chosen from the part tree, the families chosen
+        // from the data unless the pipeline has others than the intrinsic one.
+        let mut options = SegmentCollectionOptions {
+            graph: *graph,
+            cue_cache,
+            ..SegmentCollectionOptions::default()
+        };
+        options.set_pipeline(pipeline, !intrinsic_pipeline, features);
         CollectionParts {
             nodes,
             options,
-            intrinsic_pipeline: f.extrinsic.is_none() && f.sdf.is_none() && f.user.is_none(),
+            intrinsic_pipeline,
+            data: None,
             made: BTreeMap::new(),
         }
     }
 
-    /// The co-segmentation into `count` parts of [`PartsFrom::Geometry`] (made on the first
-    /// call for `count`).
+    /// The co-segmentation the parts route reads for sources with `count` distinct labels:
+    /// the bare co-segmentation ([`Self::data_parts`]) when it has at least `count` parts,
+    /// otherwise its part tree cut at `count` parts (made on the first call for `count`).
     ///
     /// Errors: those of [`segment_collection`](crate::parts::segment_collection).
     pub fn parts(
@@ -143,25 +171,87 @@ impl CollectionParts {
         smoothers: Option<&[HeatSmoother]>,
     ) -> Result<&Cosegmentation, GraphError> {
         if !self.made.contains_key(&count) {
-            let mut o = self.options.clone();
-            o.request_parts(PartsRequest::Count(count), None);
-            o.set_parts_from(
-                PartsFrom::Geometry {
-                    leaves: crate::parts::GEOMETRY_LEAVES.max(count),
-                    band: crate::parts::GEOMETRY_BAND,
-                },
-                None,
-            );
-            let s = segment_collection_sharing(self.nodes.clone(), meshes, &o, smoothers)?;
-            let intrinsic = s.features.as_ref().map_or(self.intrinsic_pipeline, |c| {
-                c.chosen == FeatureSet::Intrinsic
-            });
-            self.made.insert(count, (s.segmentation, intrinsic));
+            let made = self.finer_than(count, meshes, smoothers)?;
+            self.made.insert(count, made);
         }
         Ok(&self.made[&count].0)
     }
 
-    /// Whether the co-segmentation into `count` parts, once made, read the intrinsic family
+    /// The bare co-segmentation of `coseg segment` (made on the first call): the parts whose
+    /// number the data chose.
+    ///
+    /// Errors: those of [`segment_collection`](crate::parts::segment_collection).
+    pub fn data_parts(
+        &mut self,
+        meshes: &[TriMesh],
+        smoothers: Option<&[HeatSmoother]>,
+    ) -> Result<&Cosegmentation, GraphError> {
+        Ok(&self.data(meshes, smoothers)?.segmentation)
+    }
+
+    fn data(
+        &mut self,
+        meshes: &[TriMesh],
+        smoothers: Option<&[HeatSmoother]>,
+    ) -> Result<&DataParts, GraphError> {
+        if self.data.is_none() {
+            let s =
+                segment_collection_sharing(self.nodes.clone(), meshes, &self.options, smoothers)?;
+            let intrinsic = s.features.as_ref().map_or(self.intrinsic_pipeline, |c| {
+                c.chosen == FeatureSet::Intrinsic
+            });
+            let tree = s
+                .adaptive
+                .filter(|a| matches!(a.stop, StopReason::EqualAreaLeaves));
+            self.data = Some(DataParts {
+                segmentation: s.segmentation,
+                tree,
+                intrinsic,
+            });
+        }
+        Ok(self.data.as_ref().expect("made above"))
+    }
+
+    /// At least `count` parts: the data's cut, or its tree cut finer, or (a tree with fewer
+    /// leaves than `count`) a co-segmentation into `count` parts made for it.
+    fn finer_than(
+        &mut self,
+        count: usize,
+        meshes: &[TriMesh],
+        smoothers: Option<&[HeatSmoother]>,
+    ) -> Result<(Cosegmentation, bool), GraphError> {
+        let band = match self.options.parts_from {
+            PartsFrom::Geometry { band, .. } => band,
+            PartsFrom::Adaptive => 0.0,
+        };
+        let data = self.data(meshes, smoothers)?;
+        // Every tuple is a part to name, the leftovers' too (the tree's cut counts them).
+        if data.segmentation.tuples.len() >= count {
+            return Ok((data.segmentation.clone(), data.intrinsic));
+        }
+        if let Some(tree) = data.tree.as_ref().filter(|a| a.tree.leaves >= count) {
+            let cut = snap_part_boundaries(meshes, &tree.cut(count), band)?;
+            return Ok((cut, data.intrinsic));
+        }
+        // More labels than the tree has leaves: as many equal-area leaves as labels, cut at
+        // the number of labels.
+        let mut o = self.options.clone();
+        o.request_parts(PartsRequest::Count(count), None);
+        o.set_parts_from(
+            PartsFrom::Geometry {
+                leaves: crate::parts::GEOMETRY_LEAVES.max(count),
+                band,
+            },
+            None,
+        );
+        let s = segment_collection_sharing(self.nodes.clone(), meshes, &o, smoothers)?;
+        let intrinsic = s.features.as_ref().map_or(self.intrinsic_pipeline, |c| {
+            c.chosen == FeatureSet::Intrinsic
+        });
+        Ok((s.segmentation, intrinsic))
+    }
+
+    /// Whether the co-segmentation for `count` labels, once made, read the intrinsic family
     /// alone (the families chosen from the data, or the pipeline's when taken as given);
     /// `None` before [`Self::parts`] made it.
     pub fn intrinsic_only(&self, count: usize) -> Option<bool> {
