@@ -127,10 +127,11 @@ fn propagate_accuracy(family: &str, folder: &Path, tag: &str) -> f64 {
     right as f64 / all as f64
 }
 
-/// Both commands on `family` as shipped (`shipped`) and changed (`changed`, tagged `tag`):
-/// the two scores of each, printed (with `what`) and compared against issue 39's bar,
-/// within 1 point of the unchanged collection.
-fn compare(family: &str, shipped: &Path, changed: &Path, tag: &str, what: &str) {
+/// Both commands on `family` as shipped and changed (`changed`, tagged `tag`): the two
+/// scores of each, printed (with `what`) and compared against issue 39's bar, within 1 point
+/// of the unchanged collection.
+fn compare(family: &str, changed: &Path, tag: &str, what: &str) {
+    let shipped = &collections_dir().join(family);
     let segment = (
         // Each comparison its own scratch folders: tests may run at once.
         segment_accuracy(family, shipped, &format!("shipped_{tag}")),
@@ -159,24 +160,19 @@ fn compare(family: &str, shipped: &Path, changed: &Path, tag: &str, what: &str) 
 
 /// Both commands on `family` as shipped and moved by `seed` ([`compare`]).
 fn invariance(family: &str, seed: u64) {
-    let shipped = collections_dir().join(family);
-    let moved = moved_copy(family, seed);
-    compare(
-        family,
-        &shipped,
-        &moved,
-        "moved",
-        &format!("moved by seed {seed}"),
-    );
+    let what = format!("moved by seed {seed}");
+    compare(family, &moved_copy(family, seed), "moved", &what);
 }
 
-// Not met at commit b7d6270 (this test, `--release -- --ignored`; shipped → moved by seed 5):
-// chairs `coseg segment` 82.9 → 77.0 %, `coseg propagate` 68.5 → 62.0 %; quadrupeds
-// 94.1 → 73.1 % and 81.7 → 86.9 %. On the chairs not the alignment (the spectral family alone
-// is chosen either way): scaling, translating or permuting the coordinates exactly changes
-// nothing, while rounding them by 1e-12 alone gives 80.1 % / 56.6 % (docs/ALIGN.md,
-// "Invariance of the bare commands"). Run with
-// `cargo test --release --test e2e_invariance -- --ignored --nocapture`.
+/// The shipped `family` against its copy with each coordinate × a random 1 ± 10⁻¹² (`seed`).
+fn rounding_invariance(family: &str, seed: u64) {
+    let what = format!("× (1 ± 1e-12), seed {seed}");
+    compare(family, &perturbed_copy(family, seed), "perturbed", &what);
+}
+
+// Not met at commit 2d118bd (docs/ALIGN.md, "Invariance of the bare commands", has the
+// figures per family). Run with `cargo test --release --test e2e_invariance -- --ignored
+// --nocapture`.
 #[test]
 #[ignore = "issue 39's invariance bar is not met yet (docs/ALIGN.md, Invariance)"]
 fn chairs_segment_and_propagate_do_not_depend_on_the_files_frames() {
@@ -196,15 +192,7 @@ fn quadrupeds_segment_and_propagate_do_not_depend_on_the_files_frames() {
 /// flat seat's mean curvature, which is rounding. Both now give the shipped figures.
 #[test]
 fn chairs_segment_and_propagate_do_not_depend_on_rounding() {
-    let shipped = collections_dir().join("chairs");
-    let perturbed = perturbed_copy("chairs", 1);
-    compare(
-        "chairs",
-        &shipped,
-        &perturbed,
-        "perturbed",
-        "× (1 ± 1e-12), seed 1",
-    );
+    rounding_invariance("chairs", 1);
 }
 
 /// Regression (`a constant route's κ was rounding`, docs/ALIGN.md "Invariance of the bare
@@ -214,13 +202,5 @@ fn chairs_segment_and_propagate_do_not_depend_on_rounding() {
 /// the rigid route's pose there and the fusion's trust everywhere.
 #[test]
 fn goblets_segment_and_propagate_do_not_depend_on_rounding() {
-    let shipped = collections_dir().join("goblets");
-    let perturbed = perturbed_copy("goblets", 2);
-    compare(
-        "goblets",
-        &shipped,
-        &perturbed,
-        "perturbed",
-        "× (1 ± 1e-12), seed 2",
-    );
+    rounding_invariance("goblets", 2);
 }

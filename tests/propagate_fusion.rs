@@ -34,6 +34,17 @@ fn truth_and_noisy(d: usize, wrong: f64, seed: u64) -> (Vec<i32>, Vec<i32>) {
     (truth, noisy)
 }
 
+/// `truth` with each label on its first `tenths` tenths turned to the next one (a pose turned
+/// on that share of the shape).
+fn turned(truth: &[i32], tenths: usize) -> Vec<i32> {
+    let d = truth.len();
+    truth
+        .iter()
+        .enumerate()
+        .map(|(v, &l)| if v < tenths * d / 10 { (l + 1) % 3 } else { l })
+        .collect()
+}
+
 fn accuracy(a: &[i32], b: &[i32]) -> f64 {
     a.iter().zip(b).filter(|(x, y)| x == y).count() as f64 / a.len() as f64
 }
@@ -387,11 +398,7 @@ fn a_collapsed_rigid_route_does_not_take_the_shape_from_parts_on_other_features(
     let d = 600;
     let (truth, parts) = truth_and_noisy(d, 0.04, 5);
     let (_, affinity) = truth_and_noisy(d, 0.45, 6);
-    let rigid: Vec<i32> = truth
-        .iter()
-        .enumerate()
-        .map(|(v, &l)| if v < 6 * d / 10 { (l + 1) % 3 } else { l })
-        .collect();
+    let rigid = turned(&truth, 6);
     let routes = [route(affinity, 1.0), route(parts, 1.0), route(rigid, 1.0)];
     let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas = [vec![1.0; d], vec![1.0; d]];
@@ -554,11 +561,7 @@ fn a_pose_every_other_route_prefers_replaces_the_registrations_near_tie() {
     let d = 900;
     let (truth, parts) = truth_and_noisy(d, 0.04, 11);
     let (_, affinity) = truth_and_noisy(d, 0.45, 12);
-    let turned: Vec<i32> = truth
-        .iter()
-        .enumerate()
-        .map(|(v, &l)| if v < 6 * d / 10 { (l + 1) % 3 } else { l })
-        .collect();
+    let turned = turned(&truth, 6);
     let areas = vec![1.0; d];
     let alternatives: [&[i32]; 2] = [&turned, &truth];
     assert!(coseg::propagate::rigid_choice_is_outlier(
@@ -832,11 +835,7 @@ fn a_route_with_one_label_is_no_evidence_whatever_way_rounding_tips_kappa() {
         let (truth, affinity) = truth_and_noisy(d, 0.3, 100 + seed);
         // The registration's pose: the labels turned on most of the shape, so it disagrees
         // with the affinity.
-        let turned: Vec<i32> = truth
-            .iter()
-            .enumerate()
-            .map(|(v, &l)| if v < 8 * d / 10 { (l + 1) % 3 } else { l })
-            .collect();
+        let turned = turned(&truth, 8);
         let one_label = vec![1; d];
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(seed);
         let areas: Vec<f64> = (0..d).map(|_| 0.1 + rng.random::<f64>()).collect();
