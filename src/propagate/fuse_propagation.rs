@@ -10,7 +10,7 @@ use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNo
 use crate::mesh::TriMesh;
 use crate::parts::{
     AdaptiveCosegmentation, FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions,
-    StopReason, segment_collection_sharing, snap_part_boundaries,
+    SegmentedCollection, StopReason, segment_collection_sharing, snap_part_boundaries,
 };
 use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
@@ -94,8 +94,8 @@ pub struct CollectionParts {
     intrinsic_pipeline: bool,
     /// The bare co-segmentation, once made.
     data: Option<DataParts>,
-    /// Per number of labels: the co-segmentation the parts route reads and whether it read
-    /// the intrinsic family alone.
+    /// Per number of labels above the data's count of parts: the finer co-segmentation the
+    /// parts route reads and whether it read the intrinsic family alone.
     made: BTreeMap<usize, (Cosegmentation, bool)>,
 }
 
@@ -170,6 +170,10 @@ impl CollectionParts {
         meshes: &[TriMesh],
         smoothers: Option<&[HeatSmoother]>,
     ) -> Result<&Cosegmentation, GraphError> {
+        if self.data(meshes, smoothers)?.segmentation.tuples.len() >= count {
+            // Every tuple is a part to name, the leftovers' too (the tree's cut counts them).
+            return Ok(&self.data.as_ref().expect("made above").segmentation);
+        }
         if !self.made.contains_key(&count) {
             let made = self.finer_than(count, meshes, smoothers)?;
             self.made.insert(count, made);
@@ -197,9 +201,7 @@ impl CollectionParts {
         if self.data.is_none() {
             let s =
                 segment_collection_sharing(self.nodes.clone(), meshes, &self.options, smoothers)?;
-            let intrinsic = s.features.as_ref().map_or(self.intrinsic_pipeline, |c| {
-                c.chosen == FeatureSet::Intrinsic
-            });
+            let intrinsic = self.read_intrinsic(&s);
             let tree = s
                 .adaptive
                 .filter(|a| matches!(a.stop, StopReason::EqualAreaLeaves));
@@ -212,7 +214,15 @@ impl CollectionParts {
         Ok(self.data.as_ref().expect("made above"))
     }
 
-    /// At least `count` parts: the data's cut, or its tree cut finer, or (a tree with fewer
+    /// Whether the co-segmentation `s` read the intrinsic family alone: the families it chose
+    /// from the data, or the pipeline's when taken as given.
+    fn read_intrinsic(&self, s: &SegmentedCollection) -> bool {
+        s.features.as_ref().map_or(self.intrinsic_pipeline, |c| {
+            c.chosen == FeatureSet::Intrinsic
+        })
+    }
+
+    /// More than the data's cut of parts, `count`: its tree cut finer, or (a tree with fewer
     /// leaves than `count`) a co-segmentation into `count` parts made for it.
     fn finer_than(
         &mut self,
@@ -225,10 +235,6 @@ impl CollectionParts {
             PartsFrom::Adaptive => 0.0,
         };
         let data = self.data(meshes, smoothers)?;
-        // Every tuple is a part to name, the leftovers' too (the tree's cut counts them).
-        if data.segmentation.tuples.len() >= count {
-            return Ok((data.segmentation.clone(), data.intrinsic));
-        }
         if let Some(tree) = data.tree.as_ref().filter(|a| a.tree.leaves >= count) {
             let cut = snap_part_boundaries(meshes, &tree.cut(count), band)?;
             return Ok((cut, data.intrinsic));
@@ -245,9 +251,7 @@ impl CollectionParts {
             None,
         );
         let s = segment_collection_sharing(self.nodes.clone(), meshes, &o, smoothers)?;
-        let intrinsic = s.features.as_ref().map_or(self.intrinsic_pipeline, |c| {
-            c.chosen == FeatureSet::Intrinsic
-        });
+        let intrinsic = self.read_intrinsic(&s);
         Ok((s.segmentation, intrinsic))
     }
 
@@ -255,7 +259,10 @@ impl CollectionParts {
     /// alone (the families chosen from the data, or the pipeline's when taken as given);
     /// `None` before [`Self::parts`] made it.
     pub fn intrinsic_only(&self, count: usize) -> Option<bool> {
-        self.made.get(&count).map(|m| m.1)
+        match &self.data {
+            Some(d) if d.segmentation.tuples.len() >= count => Some(d.intrinsic),
+            _ => self.made.get(&count).map(|m| m.1),
+        }
     }
 }
 
