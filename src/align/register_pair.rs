@@ -136,29 +136,36 @@ pub fn register_pair(
 ) -> Result<Registration, AlignError> {
     options.check()?;
     let s = Prepared::new(source, options.samples, options.seed)?;
-    register_onto(&s, target, options)
+    register_onto_from(&s, target, options, &Matrix3::identity())
 }
 
 /// [`register_pair`] with the source already prepared (`Prepared::new(source, options.samples,
-/// options.seed)`), for many targets registered onto one source: the same result, the
-/// source's samples and indices made once.
-pub(crate) fn register_onto(
+/// options.seed)`), for many targets registered onto one source (the source's samples and
+/// indices made once), and with the first start `given` (a rotation taking the target's
+/// orientation onto the source's) in place of the files' own frames: where a collection
+/// alignment already relates the two shapes, its relative rotation is the start that turns
+/// with the files (the identity on files whose frames agree, so their result is unchanged),
+/// while the identity is a start only as long as the files happen to be posed alike.
+pub(crate) fn register_onto_from(
     source: &Prepared,
     target: &TriMesh,
     options: &RegisterOptions,
+    given: &Matrix3<f64>,
 ) -> Result<Registration, AlignError> {
     options.check()?;
     let t = Prepared::new(target, options.samples, options.seed)?;
-    Ok(register_prepared(source, &t, options))
+    Ok(register_prepared(source, &t, options, given))
 }
 
-/// [`register_pair`] on shapes already prepared (their samples and indices reused).
+/// [`register_pair`] on shapes already prepared (their samples and indices reused), the first
+/// start `given` ([`register_onto_from`]).
 pub(crate) fn register_prepared(
     s: &Prepared,
     t: &Prepared,
     options: &RegisterOptions,
+    given: &Matrix3<f64>,
 ) -> Registration {
-    let starts = starting_rotations(&s.moments.frame, &t.moments.frame);
+    let starts = starting_rotations(given, &s.moments.frame, &t.moments.frame);
     let coarse: Vec<Pose> = starts
         .par_iter()
         .map(|r| coarse_icp(s, t, r, options))
@@ -282,9 +289,14 @@ pub(crate) fn to_rows(m: &Matrix3<f64>) -> [[f64; 3]; 3] {
     ]
 }
 
-/// The identity, then `F_s P F_tᵀ` for the 24 proper signed permutation matrices `P`.
-pub(crate) fn starting_rotations(fs: &Matrix3<f64>, ft: &Matrix3<f64>) -> Vec<Matrix3<f64>> {
-    let mut out = vec![Matrix3::identity()];
+/// `given` (the identity: the files' own frames), then `F_s P F_tᵀ` for the 24 proper signed
+/// permutation matrices `P`.
+pub(crate) fn starting_rotations(
+    given: &Matrix3<f64>,
+    fs: &Matrix3<f64>,
+    ft: &Matrix3<f64>,
+) -> Vec<Matrix3<f64>> {
+    let mut out = vec![*given];
     out.extend(
         signed_permutations()
             .iter()

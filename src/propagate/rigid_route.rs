@@ -5,10 +5,11 @@ use super::RouteLabels;
 use super::fuse_routes::cohen_kappa;
 use super::refine_affine::refine_affine;
 use crate::align::{
-    Candidate, Prepared, RegisterOptions, Registration, Similarity, SurfaceIndex,
-    nearest_point_vertex_labels_in, register_onto,
+    AlignOptions, Candidate, FrameCase, Prepared, RegisterOptions, Registration, Similarity,
+    SurfaceIndex, align_collection, nearest_point_vertex_labels_in, register_onto_from,
 };
 use crate::mesh::TriMesh;
+use nalgebra::Matrix3;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::{Arc, Mutex};
@@ -88,9 +89,21 @@ pub(crate) struct RigidCache {
     /// once for all the targets read from it (a few sources, every target: the same work
     /// per pair would be repeated `#targets` times).
     sources: Mutex<BTreeMap<(usize, usize), Arc<SourceIndex>>>,
+    /// The collection alignment's rotation of every shape into the collection frame, keyed
+    /// by the shapes' vertex counts (made by [`RigidCache::prepare`] before the targets are
+    /// registered in parallel).
+    frames: Mutex<Option<Arc<CollectionFrames>>>,
 }
 
-/// What every pair with one source reads of it: its samples for [`register_onto`] (or why
+/// Per shape its rotation into the collection frame ([`align_collection`]), for the
+/// registrations' first start; `None` when the collection could not be aligned.
+#[derive(Debug)]
+struct CollectionFrames {
+    vertex_counts: Vec<usize>,
+    rotations: Option<Vec<Matrix3<f64>>>,
+}
+
+/// What every pair with one source reads of it: its samples for [`register_onto_from`] (or why
 /// they could not be made) and its surface index for the nearest points.
 struct SourceIndex {
     prepared: Result<Prepared, String>,
@@ -111,6 +124,7 @@ impl Clone for RigidCache {
         RigidCache {
             pairs: Mutex::new(self.lock().clone()),
             sources: Mutex::new(self.lock_sources().clone()),
+            frames: Mutex::new(self.lock_frames().clone()),
         }
     }
 }
@@ -133,6 +147,62 @@ impl RigidCache {
         &self,
     ) -> std::sync::MutexGuard<'_, BTreeMap<(usize, usize), Arc<SourceIndex>>> {
         self.sources.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    fn lock_frames(&self) -> std::sync::MutexGuard<'_, Option<Arc<CollectionFrames>>> {
+        self.frames.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// Aligns the collection `meshes` ([`align_collection`], default options) unless this
+    /// cache holds its alignment already. Called before the targets are registered in
+    /// parallel: the alignment runs in parallel itself, and made inside a worker it could
+    /// wait on itself.
+    fn prepare(&self, meshes: &[TriMesh]) {
+        let counts: Vec<usize> = meshes.iter().map(TriMesh::vertex_count).collect();
+        if self
+            .lock_frames()
+            .as_ref()
+            .is_some_and(|f| f.vertex_counts == counts)
+        {
+            return;
+        }
+        let matrix = |r: &[[f64; 3]; 3]| Matrix3::from_fn(|i, j| r[i][j]);
+        let rotations = align_collection(meshes, &AlignOptions::default())
+            .ok()
+            .map(|a| {
+                a.shapes
+                    .iter()
+                    .map(|s| match a.case {
+                        // Bit for bit the files' own frames: the start the route always had.
+                        FrameCase::AlreadyAligned | FrameCase::Single => Matrix3::identity(),
+                        FrameCase::Synchronised => matrix(&s.transform.rotation),
+                    })
+                    .collect()
+            });
+        *self.lock_frames() = Some(Arc::new(CollectionFrames {
+            vertex_counts: counts,
+            rotations,
+        }));
+    }
+
+    /// The first start of the registration of target `i` onto source `s`: the collection
+    /// alignment's relative rotation `G_sᵀ G_i` (`G` each shape's rotation into the collection
+    /// frame), the identity when the files' frames already agree or the collection was not
+    /// aligned ([`Self::prepare`]).
+    ///
+    /// Why: the identity start (the files' own frames) wins on aligned chairs (a stool onto
+    /// an armchair, docs/ALIGN.md) but is just another start once the files are moved; the
+    /// relative rotation is that start on aligned files and turns with the files otherwise.
+    /// Not also composed with the target's own symmetries (a stool's quarter turns), although
+    /// its placement in the collection frame is any of them: measured on the shipped chairs,
+    /// those starts reach lower residuals with worse labels (bare `coseg propagate` 68.8 →
+    /// 59.5 %).
+    fn start(&self, meshes: &[TriMesh], s: usize, i: usize) -> Matrix3<f64> {
+        let frames = self.lock_frames().clone();
+        frames
+            .filter(|f| f.vertex_counts.len() == meshes.len())
+            .and_then(|f| f.rotations.as_ref().map(|g| g[s].transpose() * g[i]))
+            .unwrap_or_else(Matrix3::identity)
     }
 
     /// Source `s`'s samples and surface index (made on the first call; two threads asking
@@ -172,10 +242,14 @@ impl RigidCache {
         if let Some(f) = self.lock().get(&key) {
             return f.registration.clone();
         }
-        // `register_pair(source, target)` with the source prepared once.
+        // `register_pair(source, target)` with the source prepared once, started from the
+        // collection frame.
+        let start = self.start(meshes, s, i);
         let registration = match &self.source(meshes, s).prepared {
-            Ok(source) => register_onto(source, &meshes[i], &RegisterOptions::default())
-                .map_err(|e| e.to_string()),
+            Ok(source) => {
+                register_onto_from(source, &meshes[i], &RegisterOptions::default(), &start)
+                    .map_err(|e| e.to_string())
+            }
             Err(e) => Err(e.clone()),
         };
         self.lock()
@@ -375,6 +449,9 @@ pub(crate) fn rigid_alternatives_cached(
 ) -> (Vec<Vec<RigidAlternative>>, Vec<String>) {
     let n = meshes.len();
     let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
+    if targets.iter().any(|&i| annotations[i].is_none()) {
+        cache.prepare(meshes);
+    }
     type Carried = Result<Vec<RigidAlternative>, String>;
     let results: Vec<Option<Carried>> = (0..n)
         .into_par_iter()
