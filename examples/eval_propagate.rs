@@ -40,10 +40,12 @@
 //! and rigid, only parts and rigid, none), and with several sources each route's held-out
 //! accuracy on the sources. With `COSEG_DUMP=DIR`, every run writes every route's labels and
 //! confidences on every target and the held-out runs to `DIR/run-<sources>.json` (the shapes'
-//! areas and per-vertex ground truth to `DIR/shapes.json`), for replaying fusion rules offline;
-//! each target also gets every source's registration candidates (residual, angle, the labels
-//! carried by the similarity and by its affine relaxation), and each run the co-segmentation's
-//! part ids of every shape and whether the parts read the intrinsic family alone.
+//! areas and per-vertex ground truth to `DIR/shapes.json`), for replaying fusion rules offline
+//! (`examples/replay_fusion.rs` replays the library's fusion on them); each run also gets the
+//! co-segmentation's part ids of every shape and whether the parts read the intrinsic family
+//! alone, and with `COSEG_DUMP_POSES` set each target gets every source's registration
+//! candidates (residual, angle, the labels carried by the similarity and by its affine
+//! relaxation; a registration and an affine fit per pose, so off by default).
 //! Accuracy is area-weighted: per face against `.seg` files for the chairs, per vertex for
 //! the identity sets; the source shapes are left out of every mean.
 
@@ -290,6 +292,9 @@ fn dump_run(
         std::fs::write(&shapes, serde_json::to_string(&v)?)?;
     }
     let r3 = |c: &[f64]| -> Vec<f64> { c.iter().map(|x| (x * 1000.0).round() / 1000.0).collect() };
+    // Every registration candidate costs a registration and an affine fit per pose: written
+    // only when asked for, so that a dump costs no more than the run it records.
+    let poses = std::env::var_os("COSEG_DUMP_POSES").is_some();
     let n = set.names.len();
     let targets: Vec<_> = (0..n)
         .filter(|i| !sources.contains(i))
@@ -302,7 +307,7 @@ fn dump_run(
                         r.name().to_string(),
                         json!({
                             "labels": l.labels[i],
-                            "conf": r3(&l.confidence[i]),
+                            "conf": l.confidence[i],
                             "shape_conf": l.shape_confidence[i],
                             "residual": if l.residual[i].is_finite() { l.residual[i] } else { -1.0 },
                             "score": if l.votes_on(i) { score(i, &l.labels[i]) } else { -1.0 },
@@ -312,7 +317,7 @@ fn dump_run(
                 .collect();
             json!({
                 "shape": i,
-                "candidates": candidates(set, sources, annotation, i),
+                "candidates": if poses { candidates(set, sources, annotation, i) } else { json!([]) },
                 "routes": routes,
                 "fused_score": score(i, &p.labels[i]),
                 "weights": report.fused.weights[i],
@@ -325,6 +330,7 @@ fn dump_run(
             "labels": h.labels,
             "conf": h.confidence.iter().map(|c| c.iter().map(|x| r3(x)).collect::<Vec<_>>()).collect::<Vec<_>>(),
             "scores": h.scores,
+            "accuracy": h.accuracy,
             "residual": h.residual.iter().map(|r| r.iter().map(|x| if x.is_finite() { *x } else { -1.0 }).collect::<Vec<_>>()).collect::<Vec<_>>(),
         })
     });
