@@ -54,33 +54,32 @@ fn main() -> anyhow::Result<()> {
         t.elapsed().as_secs_f64()
     );
     s.label_patch(1, 0, 1)?;
-    let t = Instant::now();
-    let second = s.propagate(|_| {})?;
-    println!(
-        "propagation after a one-shape change (full: {}, {} transports): {:.3} s",
-        second.full,
-        second.transports,
-        t.elapsed().as_secs_f64()
-    );
+    time_propagation(&mut s, "a one-shape change")?;
     // A correction of a shape that is already a source: no new (source, target) pair, so the
     // rigid route's registrations are all kept from the runs before.
     if s.label_patch(1, 1, 3)?.changed == 0 {
         s.label_patch(1, 1, 2)?;
     }
-    let t = Instant::now();
-    let third = s.propagate(|_| {})?;
-    println!(
-        "propagation after a correction of a source (full: {}, {} transports): {:.3} s",
-        third.full,
-        third.transports,
-        t.elapsed().as_secs_f64()
-    );
+    time_propagation(&mut s, "a correction of a source")?;
     let t = Instant::now();
     let png = s.thumbnail(0, 160)?;
     println!(
         "thumbnail 160 px: {:.1} ms ({} bytes)",
         t.elapsed().as_secs_f64() * 1e3,
         png.len()
+    );
+    Ok(())
+}
+
+/// Times an incremental propagation and prints it, after `change`.
+fn time_propagation(s: &mut Studio, change: &str) -> anyhow::Result<()> {
+    let t = Instant::now();
+    let run = s.propagate(|_| {})?;
+    println!(
+        "propagation after {change} (full: {}, {} transports): {:.3} s",
+        run.full,
+        run.transports,
+        t.elapsed().as_secs_f64()
     );
     Ok(())
 }

@@ -690,6 +690,18 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
         Ok(set)
     };
+    // Both labelled data sets are scored alike: single sources, then triples, as the flags say.
+    let score_sources =
+        |set: &Set, ann: &dyn Fn(usize) -> Vec<i32>, score: &dyn Fn(usize, &[i32]) -> f64| {
+            chairs(
+                set,
+                ann,
+                score,
+                &options,
+                (triples, seed, triple.as_deref()),
+                only.as_deref(),
+            )
+        };
     match mode.as_str() {
         "chairs" => {
             let dir = rest.first().ok_or("chairs DIR")?;
@@ -749,14 +761,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                 }
                 a.accuracy
             };
-            chairs(
-                &set,
-                &ann,
-                &score,
-                &options,
-                (triples, seed, triple.as_deref()),
-                only.as_deref(),
-            )
+            score_sources(&set, &ann, &score)
         }
         "labelled" => {
             // A shipped collection: meshes and `<stem>.labels.txt` (per vertex) in one folder.
@@ -781,14 +786,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
                     .unwrap()
                     .accuracy
             };
-            chairs(
-                &set,
-                &ann,
-                &score,
-                &options,
-                (triples, seed, triple.as_deref()),
-                only.as_deref(),
-            )
+            score_sources(&set, &ann, &score)
         }
         "bench" => {
             // Timing, warm cache: MESH... (the first two are labelled), `--seg DIR` for face

@@ -89,157 +89,67 @@ impl Shape {
 
 /// `(name, options, post-processing)`.
 fn configs() -> Vec<(&'static str, StableRegionsOptions, Post)> {
+    // `o` with `change` made.
+    let with = |o: &StableRegionsOptions, change: &dyn Fn(&mut StableRegionsOptions)| {
+        let mut o = o.clone();
+        change(&mut o);
+        o
+    };
     // Explicit inits: the configurations do not depend on the library's default.
-    let base = {
-        let mut opts = StableRegionsOptions::default();
-        opts.init = Init::Extreme;
-        opts
-    };
-    let auto = {
-        let mut opts = base.clone();
-        opts.algorithm = Algorithm::Auto;
-        opts
-    };
+    let base = with(&StableRegionsOptions::default(), &|o| {
+        o.init = Init::Extreme
+    });
+    let auto = with(&base, &|o| o.algorithm = Algorithm::Auto);
+    let base_random = with(&base, &|o| o.init = Init::Random);
+    let auto_random = with(&auto, &|o| o.init = Init::Random);
+    let remaining = with(&base, &|o| o.area_reference = AreaReference::Remaining);
+    let linear = with(&auto, &|o| o.t_search = TSearch::Linear);
+    let linear_cold = with(&auto_random, &|o| {
+        o.t_search = TSearch::Linear;
+        o.warm_start = false;
+    });
     vec![
-        ("alg2-extreme", base.clone(), Post::None),
-        (
-            "alg2-random",
-            {
-                let mut opts = base.clone();
-                opts.init = Init::Random;
-                opts
-            },
-            Post::None,
-        ),
-        (
-            "alg2-extreme-remaining",
-            {
-                let mut opts = base.clone();
-                opts.area_reference = AreaReference::Remaining;
-                opts
-            },
-            Post::None,
-        ),
-        ("alg3-extreme", auto.clone(), Post::None),
-        (
-            "alg3-random",
-            {
-                let mut opts = auto.clone();
-                opts.init = Init::Random;
-                opts
-            },
-            Post::None,
-        ),
-        (
-            "alg3-extreme-linear",
-            {
-                let mut opts = auto.clone();
-                opts.t_search = TSearch::Linear;
-                opts
-            },
-            Post::None,
-        ),
-        (
-            "alg3-random-linear-cold",
-            {
-                let mut opts = auto.clone();
-                opts.init = Init::Random;
-                opts.t_search = TSearch::Linear;
-                opts.warm_start = false;
-                opts
-            },
-            Post::None,
-        ),
-        (
-            "alg2-random-refined",
-            {
-                let mut opts = base.clone();
-                opts.init = Init::Random;
-                opts
-            },
-            Post::Refine,
-        ),
-        (
-            "alg3-random-refined",
-            {
-                let mut opts = auto.clone();
-                opts.init = Init::Random;
-                opts
-            },
-            Post::Refine,
-        ),
-        (
-            "alg2-random-mapped",
-            {
-                let mut opts = base.clone();
-                opts.init = Init::Random;
-                opts
-            },
-            Post::RefineMap,
-        ),
+        ("alg2-extreme", base, Post::None),
+        ("alg2-random", base_random.clone(), Post::None),
+        ("alg2-extreme-remaining", remaining, Post::None),
+        ("alg3-extreme", auto, Post::None),
+        ("alg3-random", auto_random.clone(), Post::None),
+        ("alg3-extreme-linear", linear, Post::None),
+        ("alg3-random-linear-cold", linear_cold, Post::None),
+        ("alg2-random-refined", base_random.clone(), Post::Refine),
+        ("alg3-random-refined", auto_random.clone(), Post::Refine),
+        ("alg2-random-mapped", base_random.clone(), Post::RefineMap),
         (
             "alg2-random-mapped-iso",
-            {
-                let mut opts = base.clone();
-                opts.init = Init::Random;
-                opts
-            },
+            base_random.clone(),
             Post::RefineMapIsometric,
         ),
         (
             "alg3-random-mapped-iso",
-            {
-                let mut opts = auto.clone();
-                opts.init = Init::Random;
-                opts
-            },
+            auto_random.clone(),
             Post::RefineMapIsometric,
         ),
         (
             "alg2-random-mapped-auto",
-            {
-                let mut opts = base.clone();
-                opts.init = Init::Random;
-                opts
-            },
+            base_random.clone(),
             Post::RefineMapAuto,
         ),
         (
             "alg3-random-mapped-auto",
-            {
-                let mut opts = auto.clone();
-                opts.init = Init::Random;
-                opts
-            },
+            auto_random.clone(),
             Post::RefineMapAuto,
         ),
         (
             "alg2-random-oracle-map",
-            {
-                let mut opts = base.clone();
-                opts.init = Init::Random;
-                opts
-            },
+            base_random.clone(),
             Post::RefineOracleMap(MapGuidedOptions::default().map_weight),
         ),
         (
             "alg2-random-oracle-transfer",
-            {
-                let mut opts = base.clone();
-                opts.init = Init::Random;
-                opts
-            },
+            base_random,
             Post::RefineOracleMap(1e6),
         ),
-        (
-            "alg3-random-mapped",
-            {
-                let mut opts = auto.clone();
-                opts.init = Init::Random;
-                opts
-            },
-            Post::RefineMap,
-        ),
+        ("alg3-random-mapped", auto_random, Post::RefineMap),
     ]
 }
 
@@ -263,83 +173,34 @@ fn main() -> anyhow::Result<()> {
     let (mut features, mut up, mut family_weights) =
         ("spectral".to_string(), "y".to_string(), String::new());
     let (mut directions, mut normals) = (ExtrinsicOptions::default().directions, 0usize);
-    let mut i = 0;
-    while i < args.len() {
-        let next = |i: usize| args.get(i + 1).cloned().unwrap_or_default();
-        match args[i].as_str() {
-            "--cache" => {
-                cache = next(i).into();
-                i += 1;
-            }
-            "--map-weight" => {
-                map_step.map_weight = next(i).parse()?;
-                i += 1;
-            }
+    let mut args = args.iter();
+    while let Some(arg) = args.next() {
+        // The flag's value: the next argument.
+        let mut value = || args.next().cloned().unwrap_or_default();
+        match arg.as_str() {
+            "--cache" => cache = value().into(),
+            "--map-weight" => map_step.map_weight = value().parse()?,
             "--nearest" => nearest = true,
-            "--seed" => {
-                seed = next(i).parse()?;
-                i += 1;
-            }
-            "--shapes" => {
-                shapes = next(i).parse()?;
-                i += 1;
-            }
-            "--classes" => {
-                classes = next(i).split(',').map(String::from).collect();
-                i += 1;
-            }
-            "--configs" => {
-                which = next(i);
-                i += 1;
-            }
-            "--bands" => {
-                pipe.bands.bands = next(i).parse()?;
-                i += 1;
-            }
-            "--eigenpairs" => {
-                pipe.spectrum.eigenpairs = next(i).parse()?;
-                i += 1;
-            }
+            "--seed" => seed = value().parse()?,
+            "--shapes" => shapes = value().parse()?,
+            "--classes" => classes = value().split(',').map(String::from).collect(),
+            "--configs" => which = value(),
+            "--bands" => pipe.bands.bands = value().parse()?,
+            "--eigenpairs" => pipe.spectrum.eigenpairs = value().parse()?,
             "--laplacian" => {
-                pipe.spectrum.laplacian = next(i).parse().map_err(anyhow::Error::msg)?;
-                i += 1;
+                pipe.spectrum.laplacian = value().parse().map_err(anyhow::Error::msg)?
             }
-            "--hks" => {
-                pipe.descriptors.hks_count = next(i).parse()?;
-                i += 1;
-            }
-            "--wks" => {
-                pipe.descriptors.wks_count = next(i).parse()?;
-                i += 1;
-            }
-            "--curvature" => {
-                pipe.descriptors.curvature_count = next(i).parse()?;
-                i += 1;
-            }
+            "--hks" => pipe.descriptors.hks_count = value().parse()?,
+            "--wks" => pipe.descriptors.wks_count = value().parse()?,
+            "--curvature" => pipe.descriptors.curvature_count = value().parse()?,
             "--area-bands" => pipe.bands.weighting = BandWeighting::Area,
-            "--features" => {
-                features = next(i);
-                i += 1;
-            }
-            "--up" => {
-                up = next(i);
-                i += 1;
-            }
-            "--directions" => {
-                directions = next(i).parse()?;
-                i += 1;
-            }
-            "--normals" => {
-                normals = next(i).parse()?;
-                i += 1;
-            }
-            "--family-weights" => {
-                family_weights = next(i);
-                i += 1;
-            }
+            "--features" => features = value(),
+            "--up" => up = value(),
+            "--directions" => directions = value().parse()?,
+            "--normals" => normals = value().parse()?,
+            "--family-weights" => family_weights = value(),
             d => dir = Some(PathBuf::from(d)),
         }
-        i += 1;
     }
     pipe.set_families(&features, &up, directions, normals, &family_weights)?;
     let dir = dir.ok_or_else(|| anyhow::anyhow!("usage: eval_tosca DATA_DIR [options]"))?;

@@ -290,19 +290,30 @@ fn agreement(seg: &Cosegmentation, labels: &[Vec<usize>]) -> f64 {
     hit as f64 / all as f64
 }
 
-#[test]
-fn size_aware_refinement_keeps_each_part_within_its_tolerance() {
-    let (g, labels, seg) = spread_collection();
-    let tolerance = 0.25;
-    let free = refine_cosegmentation(&g, &seg, None, &no_smoothing()).unwrap();
+/// `seg` refined without smoothing by the free best response and by the size-aware one that
+/// keeps each part within a factor `1 + tolerance` of its area.
+fn free_and_kept(
+    g: &ShapeGraph,
+    seg: &Cosegmentation,
+    tolerance: f64,
+) -> (Cosegmentation, Cosegmentation) {
+    let free = refine_cosegmentation(g, seg, None, &no_smoothing()).unwrap();
     let kept = refine_cosegmentation_sized(
-        &g,
-        &seg,
+        g,
+        seg,
         None,
         &no_smoothing(),
         RefineSizes::Keep { tolerance },
     )
     .unwrap();
+    (free, kept)
+}
+
+#[test]
+fn size_aware_refinement_keeps_each_part_within_its_tolerance() {
+    let (g, labels, seg) = spread_collection();
+    let tolerance = 0.25;
+    let (free, kept) = free_and_kept(&g, &seg, tolerance);
     let outside = |s: &Cosegmentation| {
         let mut worst: f64 = 1.0;
         for (r, t) in s.tuples.iter().enumerate() {
@@ -334,15 +345,7 @@ fn size_aware_refinement_keeps_each_part_within_its_tolerance() {
 #[test]
 fn size_aware_refinement_with_a_wide_band_is_the_free_one() {
     let (g, _, seg) = spread_collection();
-    let free = refine_cosegmentation(&g, &seg, None, &no_smoothing()).unwrap();
-    let wide = refine_cosegmentation_sized(
-        &g,
-        &seg,
-        None,
-        &no_smoothing(),
-        RefineSizes::Keep { tolerance: 1e9 },
-    )
-    .unwrap();
+    let (free, wide) = free_and_kept(&g, &seg, 1e9);
     for i in 0..4 {
         assert_eq!(free.labels(i), wide.labels(i));
     }

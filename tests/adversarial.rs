@@ -10,11 +10,13 @@
 mod common;
 
 use common::adversarial::{
-    Case, base_sphere, corpus, with_collinear_slivers, with_surface_debris, write_case,
+    Case, corpus, sphere_mesh, with_collinear_slivers, with_surface_debris, write_case,
+    write_sphere,
 };
 use common::cli::coseg;
 use common::generate::collections_dir;
 use coseg::mesh::{TriMesh, read_mesh, write_mesh};
+use std::ffi::{OsStr, OsString};
 use std::path::{Path, PathBuf};
 use std::process::Output;
 
@@ -44,6 +46,18 @@ const PIPE: &[&str] = &[
     "--bands",
     "8",
 ];
+
+/// The arguments of `coseg ARGS -o OUT [--cache CACHE]` with the small per-shape options
+/// ([`PIPE`]): how every command that writes a folder runs here.
+fn args_into(args: &[&OsStr], out: &Path, cache: Option<&Path>) -> Vec<OsString> {
+    let mut all: Vec<OsString> = args.iter().map(OsString::from).collect();
+    all.extend(["-o".as_ref(), out.as_os_str()].map(OsString::from));
+    if let Some(cache) = cache {
+        all.extend(["--cache".as_ref(), cache.as_os_str()].map(OsString::from));
+    }
+    all.extend(PIPE.iter().map(OsString::from));
+    all
+}
 
 /// What a command did on one mesh.
 #[derive(Debug, PartialEq)]
@@ -220,36 +234,34 @@ fn run_all(case: &Case, root: &Path, partner: &Path) -> Vec<(String, Verdict)> {
 
     for format in ["npy", "csv"] {
         let fdir = dir.join(format!("features_{format}"));
-        let mut args: Vec<std::ffi::OsString> = vec![
-            "features".into(),
-            mesh.clone().into(),
-            "-o".into(),
-            fdir.clone().into(),
-            "--format".into(),
-            format.into(),
-            "--cache".into(),
-            cache.clone().into(),
-        ];
-        args.extend(PIPE.iter().map(Into::into));
+        let args = args_into(
+            &[
+                "features".as_ref(),
+                mesh.as_os_str(),
+                "--format".as_ref(),
+                format.as_ref(),
+            ],
+            &fdir,
+            Some(&cache),
+        );
         record(&format!("features {format}"), coseg(&args), Some(&fdir));
     }
 
     for (what, other) in [("pair with a sphere", partner), ("pair with itself", &mesh)] {
         let pdir = dir.join(what.replace(' ', "_"));
-        let mut args: Vec<std::ffi::OsString> = vec![
-            "pair".into(),
-            mesh.clone().into(),
-            other.into(),
-            "-o".into(),
-            pdir.clone().into(),
-            "--cache".into(),
-            cache.clone().into(),
-            "--refine-rounds".into(),
-            "3".into(),
-            "--map-size".into(),
-            "30".into(),
-        ];
-        args.extend(PIPE.iter().map(Into::into));
+        let args = args_into(
+            &[
+                "pair".as_ref(),
+                mesh.as_os_str(),
+                other.as_ref(),
+                "--refine-rounds".as_ref(),
+                "3".as_ref(),
+                "--map-size".as_ref(),
+                "30".as_ref(),
+            ],
+            &pdir,
+            Some(&cache),
+        );
         record(what, coseg(&args), Some(&pdir));
     }
 
@@ -257,28 +269,21 @@ fn run_all(case: &Case, root: &Path, partner: &Path) -> Vec<(String, Verdict)> {
     std::fs::create_dir_all(&folder).unwrap();
     std::fs::copy(&mesh, folder.join(file)).unwrap();
     for seed in [11, 12] {
-        let (p, f) = base_sphere(seed);
-        write_mesh(
-            folder.join(format!("sphere{seed}.off")),
-            &TriMesh::new(p, f).unwrap(),
-            &[],
-        )
-        .unwrap();
+        write_sphere(&folder.join(format!("sphere{seed}.off")), seed);
     }
     let sdir = dir.join("segment");
-    let mut args: Vec<std::ffi::OsString> = vec![
-        "segment".into(),
-        folder.clone().into(),
-        "-o".into(),
-        sdir.clone().into(),
-        "--cache".into(),
-        cache.clone().into(),
-        "--regions".into(),
-        "3".into(),
-        "--refine-rounds".into(),
-        "3".into(),
-    ];
-    args.extend(PIPE.iter().map(Into::into));
+    let args = args_into(
+        &[
+            "segment".as_ref(),
+            folder.as_os_str(),
+            "--regions".as_ref(),
+            "3".as_ref(),
+            "--refine-rounds".as_ref(),
+            "3".as_ref(),
+        ],
+        &sdir,
+        Some(&cache),
+    );
     record("segment", coseg(&args), Some(&sdir));
 
     // propagate, both ways over the same folder: from a clean sphere's per-vertex labels onto
@@ -302,17 +307,16 @@ fn run_all(case: &Case, root: &Path, partner: &Path) -> Vec<(String, Verdict)> {
         ("propagate from the case", &seg, &[3, 4][..]),
     ] {
         let pdir = dir.join(what.replace(' ', "_"));
-        let mut args: Vec<std::ffi::OsString> = vec![
-            "propagate".into(),
-            folder.clone().into(),
-            "--labels".into(),
-            labels.into(),
-            "-o".into(),
-            pdir.clone().into(),
-            "--cache".into(),
-            cache.clone().into(),
-        ];
-        args.extend(PIPE.iter().map(Into::into));
+        let args = args_into(
+            &[
+                "propagate".as_ref(),
+                folder.as_os_str(),
+                "--labels".as_ref(),
+                labels.as_ref(),
+            ],
+            &pdir,
+            Some(&cache),
+        );
         let o = coseg(&args);
         let ok = matches!(o.status.code(), Some(0) | Some(3));
         record(what, o, Some(&pdir));
@@ -401,8 +405,7 @@ fn check_propagated(out: &Path, folder: &Path, parts: &[i32]) {
 fn every_command_on_the_adversarial_corpus_succeeds_without_nan() {
     let root = scratch("corpus");
     let partner = root.join("partner.off");
-    let (p, f) = base_sphere(10);
-    write_mesh(&partner, &TriMesh::new(p, f).unwrap(), &[]).unwrap();
+    write_sphere(&partner, 10);
     let mut table = Vec::new();
     for case in corpus() {
         for (what, v) in run_all(&case, &root, &partner) {
@@ -467,24 +470,19 @@ fn pair_on_multi_component_shapes_runs_the_map_step() {
 fn segment_into_its_own_input_folder_does_not_read_its_outputs() {
     let dir = scratch("same_folder");
     for seed in [1, 2, 3] {
-        let (p, f) = base_sphere(seed);
-        write_mesh(
-            dir.join(format!("s{seed}.off")),
-            &TriMesh::new(p, f).unwrap(),
-            &[],
-        )
-        .unwrap();
+        write_sphere(&dir.join(format!("s{seed}.off")), seed);
     }
     let run = || {
-        let mut args: Vec<std::ffi::OsString> = vec![
-            "segment".into(),
-            dir.clone().into(),
-            "-o".into(),
-            dir.clone().into(),
-            "--regions".into(),
-            "3".into(),
-        ];
-        args.extend(PIPE.iter().map(Into::into));
+        let args = args_into(
+            &[
+                "segment".as_ref(),
+                dir.as_os_str(),
+                "--regions".as_ref(),
+                "3".as_ref(),
+            ],
+            &dir,
+            None,
+        );
         coseg(&args)
     };
     let first = run();
@@ -512,19 +510,19 @@ fn two_files_with_one_stem_get_distinct_output_names() {
     let input = dir.join("in");
     std::fs::create_dir_all(&input).unwrap();
     for (seed, name) in [(1, "g.obj"), (2, "g.off"), (3, "h.ply")] {
-        let (p, f) = base_sphere(seed);
-        write_mesh(input.join(name), &TriMesh::new(p, f).unwrap(), &[]).unwrap();
+        write_sphere(&input.join(name), seed);
     }
     let out = dir.join("out");
-    let mut args: Vec<std::ffi::OsString> = vec![
-        "segment".into(),
-        input.into(),
-        "-o".into(),
-        out.clone().into(),
-        "--regions".into(),
-        "3".into(),
-    ];
-    args.extend(PIPE.iter().map(Into::into));
+    let args = args_into(
+        &[
+            "segment".as_ref(),
+            input.as_ref(),
+            "--regions".as_ref(),
+            "3".as_ref(),
+        ],
+        &out,
+        None,
+    );
     let o = coseg(&args);
     let (_, stderr) = text(&o);
     assert!(o.status.success(), "{stderr}");
@@ -613,13 +611,7 @@ fn segment_pair_falls_back_to_the_refined_regions_when_the_map_step_cannot_run()
     use coseg::stable::{PairShape, PairStage, SegmentPairOptions, segment_pair};
     let mut pipe = common::features::small_pipeline(40, 8);
     pipe.bands.bands = 6;
-    let meshes: Vec<TriMesh> = [1, 2]
-        .iter()
-        .map(|&s| {
-            let (p, f) = base_sphere(s);
-            TriMesh::new(p, f).unwrap()
-        })
-        .collect();
+    let meshes: Vec<TriMesh> = [1, 2].iter().map(|&s| sphere_mesh(s)).collect();
     let data: Vec<_> = meshes
         .iter()
         .map(|m| compute_shape_data(m, &pipe).unwrap())
@@ -681,13 +673,7 @@ fn propagate_refuses_bad_label_files_naming_them() {
     let folder = dir.join("meshes");
     std::fs::create_dir_all(&folder).unwrap();
     for seed in [1, 2, 3] {
-        let (p, f) = base_sphere(seed);
-        write_mesh(
-            folder.join(format!("s{seed}.off")),
-            &TriMesh::new(p, f).unwrap(),
-            &[],
-        )
-        .unwrap();
+        write_sphere(&folder.join(format!("s{seed}.off")), seed);
     }
     let m = read_mesh(folder.join("s1.off")).unwrap();
     let (d, nf) = (m.vertex_count(), m.face_count());
@@ -774,17 +760,16 @@ fn propagate_refuses_bad_label_files_naming_them() {
         let file = labels.join(name);
         std::fs::write(&file, bytes).unwrap();
         let out = dir.join(format!("out{i}"));
-        let mut args: Vec<std::ffi::OsString> = vec![
-            "propagate".into(),
-            folder.clone().into(),
-            "--labels".into(),
-            file.clone().into(),
-            "-o".into(),
-            out.clone().into(),
-            "--cache".into(),
-            cache.clone().into(),
-        ];
-        args.extend(PIPE.iter().map(Into::into));
+        let args = args_into(
+            &[
+                "propagate".as_ref(),
+                folder.as_os_str(),
+                "--labels".as_ref(),
+                file.as_os_str(),
+            ],
+            &out,
+            Some(&cache),
+        );
         let o = coseg(&args);
         let (_, stderr) = text(&o);
         assert_eq!(
@@ -814,17 +799,16 @@ fn propagate_refuses_bad_label_files_naming_them() {
     let stray = dir.join("stray");
     std::fs::create_dir_all(&stray).unwrap();
     std::fs::write(stray.join("chair.labels.txt"), "1\n").unwrap();
-    let mut args: Vec<std::ffi::OsString> = vec![
-        "propagate".into(),
-        folder.into(),
-        "--labels".into(),
-        stray.clone().into(),
-        "-o".into(),
-        dir.join("out_stray").into(),
-        "--cache".into(),
-        cache.into(),
-    ];
-    args.extend(PIPE.iter().map(Into::into));
+    let args = args_into(
+        &[
+            "propagate".as_ref(),
+            folder.as_ref(),
+            "--labels".as_ref(),
+            stray.as_os_str(),
+        ],
+        &dir.join("out_stray"),
+        Some(&cache),
+    );
     let o = coseg(&args);
     let (_, stderr) = text(&o);
     assert_eq!(verdict("stray folder", "stray", &o), Verdict::Refused);

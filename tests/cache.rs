@@ -7,9 +7,10 @@ use common::features::{blob, permutation, permute_mesh};
 use coseg::cache::{CacheOutcome, cache_path, mesh_hash};
 use coseg::mesh::TriMesh;
 use coseg::pipeline::{
-    ShapeData, ShapePipelineOptions, compute_shape_data, encode_shape_entry as encode_entry,
-    load_or_compute, shape_key,
+    CacheResult, ShapeData, ShapePipelineOptions, compute_shape_data,
+    encode_shape_entry as encode_entry, load_or_compute, shape_key,
 };
+use tempfile::TempDir;
 
 fn opts() -> ShapePipelineOptions {
     common::features::small_pipeline(20, 6)
@@ -19,15 +20,22 @@ fn mesh() -> TriMesh {
     blob(2)
 }
 
+/// A fresh cache folder, the test mesh and options, and their first `load_or_compute` there
+/// (a miss that writes the entry).
+fn first_entry() -> (TempDir, TriMesh, ShapePipelineOptions, CacheResult) {
+    let dir = tempfile::tempdir().unwrap();
+    let (m, o) = (mesh(), opts());
+    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    (dir, m, o, first)
+}
+
 fn is_recomputed(o: &CacheOutcome, needle: &str) -> bool {
     matches!(o, CacheOutcome::Recomputed { reason } if reason.contains(needle))
 }
 
 #[test]
 fn miss_then_hit_with_identical_data() {
-    let dir = tempfile::tempdir().unwrap();
-    let (m, o) = (mesh(), opts());
-    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    let (dir, m, o, first) = first_entry();
     assert_eq!(first.outcome, CacheOutcome::Miss);
     assert!(first.write_error.is_none());
     assert!(first.path.exists());
@@ -49,9 +57,7 @@ fn computation_is_bitwise_reproducible() {
 
 #[test]
 fn every_flipped_payload_byte_region_and_truncation_is_detected() {
-    let dir = tempfile::tempdir().unwrap();
-    let (m, o) = (mesh(), opts());
-    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    let (dir, m, o, first) = first_entry();
     let good = std::fs::read(&first.path).unwrap();
     // Positions across header and payload.
     let len = good.len();
@@ -105,9 +111,7 @@ fn every_flipped_payload_byte_region_and_truncation_is_detected() {
 
 #[test]
 fn a_changed_option_or_mesh_gets_another_entry() {
-    let dir = tempfile::tempdir().unwrap();
-    let (m, o) = (mesh(), opts());
-    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    let (dir, m, o, first) = first_entry();
     let mut o2 = o.clone();
     o2.bands.bands = 5;
     let second = load_or_compute(&m, &o2, dir.path()).unwrap();
@@ -148,9 +152,7 @@ fn a_changed_option_or_mesh_gets_another_entry() {
 
 #[test]
 fn an_entry_stored_under_the_wrong_key_is_stale() {
-    let dir = tempfile::tempdir().unwrap();
-    let (m, o) = (mesh(), opts());
-    let first = load_or_compute(&m, &o, dir.path()).unwrap();
+    let (dir, m, o, first) = first_entry();
     let mut o2 = o.clone();
     o2.descriptors.hks_count = 3;
     // Someone copies the old entry to the new key's name: the header's key gives it away.

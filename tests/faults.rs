@@ -9,10 +9,10 @@
 
 mod common;
 
-use common::adversarial::base_sphere;
+use common::adversarial::sphere_mesh as sphere;
 use common::features::small_pipeline;
 use coseg::cache::{CacheOutcome, cache_path};
-use coseg::mesh::{TriMesh, write_atomic, write_mesh};
+use coseg::mesh::{write_atomic, write_mesh};
 use coseg::pipeline::{
     ShapePipelineOptions, compute_shape_data, decode_shape_entry, encode_shape_entry,
     load_or_compute, load_or_compute_bands, shape_key,
@@ -36,11 +36,6 @@ fn scratch(name: &str) -> PathBuf {
     }
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn sphere(seed: u64) -> TriMesh {
-    let (p, f) = base_sphere(seed);
-    TriMesh::new(p, f).unwrap()
 }
 
 fn options() -> ShapePipelineOptions {

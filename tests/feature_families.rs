@@ -163,6 +163,17 @@ fn shipped_chair() -> TriMesh {
     coseg::mesh::read_mesh(&p).unwrap()
 }
 
+/// The shipped chair, the default SDF options, and the SDF of the chair before and after a
+/// similarity (rotation, translation, scale 3.5).
+fn chair_sdf_before_and_after_a_similarity() -> (TriMesh, SdfOptions, FeatureColumns, FeatureColumns)
+{
+    let m = shipped_chair();
+    let o = SdfOptions::default();
+    let base = shape_diameter(&m, &o).unwrap();
+    let moved = shape_diameter(&similarity(&m, 3.5), &o).unwrap();
+    (m, o, base, moved)
+}
+
 #[test]
 fn sdf_of_a_sphere_is_the_median_chord_of_the_cone() {
     // A ray leaving a unit sphere at angle θ from the inner normal has chord 2 cos θ; the cone
@@ -207,10 +218,7 @@ fn sdf_orients_each_component_and_sees_their_thickness() {
 
 #[test]
 fn sdf_ranks_survive_rigid_motion_scaling_and_permutation_on_a_shipped_shape() {
-    let m = shipped_chair();
-    let o = SdfOptions::default();
-    let base = shape_diameter(&m, &o).unwrap();
-    let moved = shape_diameter(&similarity(&m, 3.5), &o).unwrap();
+    let (m, o, base, moved) = chair_sdf_before_and_after_a_similarity();
     let perm = permutation(m.vertex_count(), 7);
     let permuted = shape_diameter(&permute_mesh(&m, &perm), &o).unwrap();
     for f in 0..base.len() {
@@ -235,10 +243,7 @@ fn sdf_ranks_survive_rigid_motion_scaling_and_permutation_on_a_shipped_shape() {
 /// vertex's first edge): a moved, scaled chair gives the same values up to rounding.
 #[test]
 fn sdf_cones_turn_with_the_mesh_so_a_rotated_chair_keeps_its_thicknesses() {
-    let m = shipped_chair();
-    let o = SdfOptions::default();
-    let base = shape_diameter(&m, &o).unwrap();
-    let moved = shape_diameter(&similarity(&m, 3.5), &o).unwrap();
+    let (_, _, base, moved) = chair_sdf_before_and_after_a_similarity();
     for f in 0..base.len() {
         let worst = base
             .column(f)

@@ -284,6 +284,14 @@ fn optional_parts_are_present_on_some_shapes_and_absent_on_others() {
     }
 }
 
+/// The leg parts of the quadrupeds and of the chairs (the two families name them alike).
+const FOUR_LEGS: [&str; 4] = [
+    "leg_front_left",
+    "leg_front_right",
+    "leg_back_left",
+    "leg_back_right",
+];
+
 #[test]
 fn labels_sit_where_the_parts_are() {
     // Quadrupeds: head in front of the torso, tail behind, legs below.
@@ -296,12 +304,7 @@ fn labels_sit_where_the_parts_are() {
             "{}",
             s.name
         );
-        for leg in [
-            "leg_front_left",
-            "leg_front_right",
-            "leg_back_left",
-            "leg_back_right",
-        ] {
+        for leg in FOUR_LEGS {
             assert!(c(leg)[1] < torso[1], "{}: {leg}", s.name);
         }
         assert!(c("leg_front_left")[2] > 0.0 && c("leg_front_right")[2] < 0.0);
@@ -343,12 +346,7 @@ fn labels_sit_where_the_parts_are() {
     for s in &collection(f).shapes {
         let c = |n| centroid(&s.mesh, &s.labels, part_index(f, n));
         let seat = c("seat");
-        for leg in [
-            "leg_front_left",
-            "leg_front_right",
-            "leg_back_left",
-            "leg_back_right",
-        ] {
+        for leg in FOUR_LEGS {
             assert!(c(leg)[1] < seat[1], "{}: {leg}", s.name);
         }
         if s.parts_present[part_index(f, "back") as usize] {

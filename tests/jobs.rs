@@ -3,7 +3,9 @@
 mod common;
 
 use common::features::{blob, similarity, small_pipeline};
-use coseg::jobs::{CacheChoice, EvalJob, JobError, JobShape, PairJob, run_eval, run_pair};
+use coseg::jobs::{
+    CacheChoice, EvalJob, JobError, JobShape, PairJob, PairOutcome, run_eval, run_pair,
+};
 use std::path::{Path, PathBuf};
 
 fn small_job(output: Option<PathBuf>) -> PairJob {
@@ -20,6 +22,14 @@ fn two_files(dir: &Path) -> [PathBuf; 2] {
     coseg::mesh::write_mesh(&a, &blob(2), &[]).unwrap();
     coseg::mesh::write_mesh(&b, &similarity(&blob(2), 1.3), &[]).unwrap();
     [a, b]
+}
+
+/// `run_pair` on two mesh files into `out`, with the small test job.
+fn pair_files(a: PathBuf, b: PathBuf, out: &Path) -> Result<PairOutcome, JobError> {
+    run_pair(
+        [JobShape::File(a), JobShape::File(b)],
+        &small_job(Some(out.to_path_buf())),
+    )
 }
 
 fn region_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
@@ -96,11 +106,7 @@ fn two_shapes_with_one_name_are_both_written() {
     let dir = tempfile::tempdir().unwrap();
     let [a, _] = two_files(dir.path());
     let out = dir.path().join("out");
-    let outcome = run_pair(
-        [JobShape::File(a.clone()), JobShape::File(a)],
-        &small_job(Some(out.clone())),
-    )
-    .unwrap();
+    let outcome = pair_files(a.clone(), a, &out).unwrap();
     assert_eq!(outcome.names, ["a_a", "a"]);
     assert_eq!(region_files(&out).len(), 2);
 }
@@ -113,11 +119,7 @@ fn a_bad_mesh_is_refused_with_its_name() {
     let bad = dir.path().join("bad.off");
     std::fs::write(&bad, "OFF\n3 1 0\n0 0 0\n").unwrap();
     let out = dir.path().join("out");
-    let err = run_pair(
-        [JobShape::File(a), JobShape::File(bad)],
-        &small_job(Some(out.clone())),
-    )
-    .unwrap_err();
+    let err = pair_files(a, bad, &out).unwrap_err();
     let text = err.to_string();
     assert!(text.contains("bad.off"), "{text}");
     assert!(matches!(err, JobError::Mesh(_) | JobError::Shape { .. }));
@@ -139,11 +141,7 @@ fn eval_job_writes_its_scores_and_names_what_it_cannot_score() {
     let dir = tempfile::tempdir().unwrap();
     let [a, b] = two_files(dir.path());
     let out = dir.path().join("out");
-    let outcome = run_pair(
-        [JobShape::File(a), JobShape::File(b)],
-        &small_job(Some(out.clone())),
-    )
-    .unwrap();
+    let outcome = pair_files(a, b, &out).unwrap();
     let truth = dir.path().join("truth");
     std::fs::create_dir(&truth).unwrap();
     for (name, labels) in outcome.names.iter().zip(&outcome.labels) {

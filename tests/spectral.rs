@@ -35,11 +35,7 @@ fn l_times(mesh: &TriMesh, x: &[f64]) -> Vec<f64> {
 fn residuals(mesh: &TriMesh, s: &Spectrum) -> (f64, f64) {
     let d = s.vertex_count();
     let m = &s.vertex_areas;
-    let mut worst_res = 0.0f64;
-    for i in 0..s.len() {
-        let phi = s.eigenvector(i);
-        let lphi = l_times(mesh, phi);
-        let lam = s.eigenvalues[i];
+    let worst_res = worst_over_pairs(mesh, s, |phi, lphi, lam| {
         let mut r2 = 0.0;
         for v in 0..d {
             if m[v] > 0.0 {
@@ -47,8 +43,8 @@ fn residuals(mesh: &TriMesh, s: &Spectrum) -> (f64, f64) {
                 r2 += r * r / m[v];
             }
         }
-        worst_res = worst_res.max(r2.sqrt() / (1.0 + lam));
-    }
+        r2.sqrt() / (1.0 + lam)
+    });
     let mut worst_orth = 0.0f64;
     for i in 0..s.len() {
         for j in 0..=i {
@@ -65,11 +61,7 @@ fn residuals(mesh: &TriMesh, s: &Spectrum) -> (f64, f64) {
 /// Max over pairs of ‖Lφ − λMφ‖₂ / (‖Lφ‖₂ + λ‖Mφ‖₂ + ‖Mφ‖₂).
 fn euclidean_residual(mesh: &TriMesh, s: &Spectrum) -> f64 {
     let m = &s.vertex_areas;
-    let mut worst = 0.0f64;
-    for i in 0..s.len() {
-        let phi = s.eigenvector(i);
-        let lphi = l_times(mesh, phi);
-        let lam = s.eigenvalues[i];
+    worst_over_pairs(mesh, s, |phi, lphi, lam| {
         let (mut r2, mut l2, mut m2) = (0.0, 0.0, 0.0);
         for v in 0..phi.len() {
             let mp = m[v] * phi[v];
@@ -77,9 +69,22 @@ fn euclidean_residual(mesh: &TriMesh, s: &Spectrum) -> f64 {
             l2 += lphi[v] * lphi[v];
             m2 += mp * mp;
         }
-        worst = worst.max(r2.sqrt() / (l2.sqrt() + (1.0 + lam) * m2.sqrt()));
-    }
-    worst
+        r2.sqrt() / (l2.sqrt() + (1.0 + lam) * m2.sqrt())
+    })
+}
+
+/// The largest `residual(φ, Lφ, λ)` over the eigenpairs of `s`.
+fn worst_over_pairs(
+    mesh: &TriMesh,
+    s: &Spectrum,
+    residual: impl Fn(&[f64], &[f64], f64) -> f64,
+) -> f64 {
+    (0..s.len())
+        .map(|i| {
+            let phi = s.eigenvector(i);
+            residual(phi, &l_times(mesh, phi), s.eigenvalues[i])
+        })
+        .fold(0.0f64, f64::max)
 }
 
 /// Largest principal-angle sine between span(a[..k]) and span(b[..k]) in the M inner product:
@@ -441,18 +446,11 @@ fn heat_smoother_keeps_constants_and_integrals() {
 
 mod zoomout_map {
     use super::common::features::{blob, permutation, permute_mesh};
-    use coseg::maps::{FinalMatch, ShapeGeometry, ZoomOutOptions, zoomout};
+    use coseg::maps::{FinalMatch, ShapeGeometry, zoomout};
     use coseg::mesh::TriMesh;
     use coseg::spectral::{Spectrum, SpectrumOptions, laplace_beltrami_spectrum};
 
-    fn options() -> ZoomOutOptions {
-        let mut opts = ZoomOutOptions::default();
-        opts.initial_size = 6;
-        opts.final_size = 40;
-        opts.step = 5;
-        opts.samples = 300;
-        opts
-    }
+    use super::common::features::small_zoomout as options;
 
     /// A = a blob, B = the same blob with its vertices permuted (`perm[new] = old`).
     fn permuted_pair() -> (TriMesh, TriMesh, Vec<usize>, Spectrum, Spectrum) {
@@ -638,14 +636,10 @@ mod zoomout_descriptors {
         let (ga, gb) = (geometry(&a, &sa, &da), geometry(&b, &sb, &db));
         let run = |weight: f64| {
             let options = {
-                let mut opts = ZoomOutOptions::default();
-                opts.initial_size = 6;
-                opts.final_size = 40;
-                opts.step = 5;
-                opts.samples = 300;
+                let mut opts = super::common::features::small_zoomout();
                 opts.descriptor_weight = weight;
-                opts.// One-to-one matching would hide what the descriptors add.
-                final_match = FinalMatch::Nearest;
+                // One-to-one matching would hide what the descriptors add.
+                opts.final_match = FinalMatch::Nearest;
                 opts
             };
             zoomout(ga, gb, &truth, &options)
@@ -949,18 +943,28 @@ mod auction {
     }
 }
 
+/// How far apart two shapes' spectra are, and the map preset chosen from it.
 mod discrepancy {
     use super::common::features::{blob, permutation, permute_mesh, spectrum_of};
-    use coseg::maps::eigenvalue_discrepancy;
+    use coseg::maps::{MapGuidedOptions, MapPreset, eigenvalue_discrepancy, map_preset};
+    use coseg::mesh::TriMesh;
+    use coseg::spectral::Spectrum;
+
+    /// The test blob, its spectrum of `k` eigenpairs, and a copy with its vertices permuted
+    /// by a seeded permutation (the same surface).
+    fn blob_and_permuted_copy(k: usize, seed: u64) -> (TriMesh, Spectrum, TriMesh) {
+        let a = blob(2);
+        let sa = spectrum_of(&a, k);
+        let copy = permute_mesh(&a, &permutation(a.vertex_count(), seed));
+        (a, sa, copy)
+    }
 
     #[test]
     fn eigenvalue_discrepancy_is_zero_for_isometric_copies_and_grows_with_stretch() {
-        let a = blob(2);
         let spectrum = |m| spectrum_of(m, 20);
-        let sa = spectrum(&a);
+        let (a, sa, permuted) = blob_and_permuted_copy(20, 3);
         // Permuted, scaled and rotated copies have the same unit-area spectrum.
-        let perm = permutation(a.vertex_count(), 3);
-        let copy = permute_mesh(&a, &perm)
+        let copy = permuted
             .map_positions(|p| [3.0 * p[1], -3.0 * p[0], 3.0 * p[2] + 1.0])
             .unwrap();
         let same = eigenvalue_discrepancy(&sa, &spectrum(&copy), 20).unwrap();
@@ -978,6 +982,30 @@ mod discrepancy {
         );
         assert!(eigenvalue_discrepancy(&sa, &s1, 1).is_err());
         assert!(eigenvalue_discrepancy(&sa, &s1, 21).is_err());
+    }
+
+    #[test]
+    fn map_preset_tells_a_repose_from_a_different_body() {
+        let spectrum = |m| spectrum_of(m, 24);
+        let (a, sa, copy) = blob_and_permuted_copy(24, 9);
+        let same = map_preset(&sa, &spectrum(&copy)).unwrap();
+        assert_eq!(same.preset, MapPreset::NearIsometric);
+        assert!(same.discrepancy < 1e-6);
+        let other = a.map_positions(|p| [1.6 * p[0], p[1], p[2]]).unwrap();
+        let different = map_preset(&sa, &spectrum(&other)).unwrap();
+        assert_eq!(different.preset, MapPreset::General);
+        assert!(different.discrepancy > 1e3 * same.discrepancy.max(1e-9));
+        assert_eq!(MapPreset::General.options(), MapGuidedOptions::default());
+        assert_eq!(
+            MapPreset::NearIsometric.options(),
+            MapGuidedOptions::near_isometric()
+        );
+        // Spectra shorter than the 20 eigenvalues compared: the common length is used.
+        let short = spectrum_of(&a, 5);
+        assert_eq!(
+            map_preset(&sa, &short).unwrap().preset,
+            MapPreset::NearIsometric
+        );
     }
 }
 

@@ -700,7 +700,6 @@ fn refine_regions_rebuilds_pairs_with_dense_objectives() {
 mod map_guided {
     use super::common::features::{blob, permutation, permute_mesh};
     use coseg::affinity::{BandAffinity, Direction};
-    use coseg::maps::ZoomOutOptions;
     use coseg::maps::{MapGuidedOptions, MapStep};
     use coseg::maps::{MapShape, PointMapOptions, ShapeGeometry, region_point_map};
     use coseg::mesh::TriMesh;
@@ -719,14 +718,7 @@ mod map_guided {
 
     fn options() -> PointMapOptions {
         let mut o2 = PointMapOptions::default();
-        o2.zoomout = {
-            let mut opts = ZoomOutOptions::default();
-            opts.initial_size = 6;
-            opts.final_size = 40;
-            opts.step = 5;
-            opts.samples = 300;
-            opts
-        };
+        o2.zoomout = super::common::features::small_zoomout();
         o2
     }
 
@@ -1184,38 +1176,6 @@ mod map_guided {
             options.feature_weights = Some(vec![0.37; da.bands.features]);
             assert_eq!(segment_pair(sa, sb, &options).unwrap().regions, default);
         }
-    }
-}
-
-mod preset {
-    use super::common::features::{blob, permutation, permute_mesh, spectrum_of};
-    use coseg::maps::MapGuidedOptions;
-    use coseg::maps::{MapPreset, map_preset};
-
-    #[test]
-    fn map_preset_tells_a_repose_from_a_different_body() {
-        let a = blob(2);
-        let spectrum = |m| spectrum_of(m, 24);
-        let sa = spectrum(&a);
-        let copy = permute_mesh(&a, &permutation(a.vertex_count(), 9));
-        let same = map_preset(&sa, &spectrum(&copy)).unwrap();
-        assert_eq!(same.preset, MapPreset::NearIsometric);
-        assert!(same.discrepancy < 1e-6);
-        let other = a.map_positions(|p| [1.6 * p[0], p[1], p[2]]).unwrap();
-        let different = map_preset(&sa, &spectrum(&other)).unwrap();
-        assert_eq!(different.preset, MapPreset::General);
-        assert!(different.discrepancy > 1e3 * same.discrepancy.max(1e-9));
-        assert_eq!(MapPreset::General.options(), MapGuidedOptions::default());
-        assert_eq!(
-            MapPreset::NearIsometric.options(),
-            MapGuidedOptions::near_isometric()
-        );
-        // Spectra shorter than the 20 eigenvalues compared: the common length is used.
-        let short = spectrum_of(&a, 5);
-        assert_eq!(
-            map_preset(&sa, &short).unwrap().preset,
-            MapPreset::NearIsometric
-        );
     }
 }
 

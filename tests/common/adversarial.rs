@@ -27,6 +27,17 @@ pub fn base_sphere(seed: u64) -> Parts {
     (p, f)
 }
 
+/// [`base_sphere`] as a mesh.
+pub fn sphere_mesh(seed: u64) -> TriMesh {
+    let (p, f) = base_sphere(seed);
+    TriMesh::new(p, f).unwrap()
+}
+
+/// Writes [`base_sphere`]`(seed)` to `path` (its extension picks the format).
+pub fn write_sphere(path: &Path, seed: u64) {
+    write_mesh(path, &sphere_mesh(seed), &[]).unwrap();
+}
+
 fn single_triangle(at: [f64; 3], size: f64) -> Parts {
     (
         vec![

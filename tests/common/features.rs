@@ -103,6 +103,16 @@ pub fn small_pipeline(eigenpairs: usize, per_kind: usize) -> coseg::pipeline::Sh
     o
 }
 
+/// A small ZoomOut for tests: spectral sizes 6 to 40 in steps of 5, 300 samples.
+pub fn small_zoomout() -> coseg::maps::ZoomOutOptions {
+    let mut opts = coseg::maps::ZoomOutOptions::default();
+    opts.initial_size = 6;
+    opts.final_size = 40;
+    opts.step = 5;
+    opts.samples = 300;
+    opts
+}
+
 /// The `k` smallest Laplace–Beltrami eigenpairs of `mesh` (the library's other defaults).
 pub fn spectrum_of(mesh: &coseg::mesh::TriMesh, k: usize) -> coseg::spectral::Spectrum {
     coseg::spectral::laplace_beltrami_spectrum(
