@@ -37,6 +37,7 @@ pub mod bands;
 pub mod cache;
 pub mod evaluate;
 pub mod features;
+mod file_error;
 pub mod generate;
 pub mod graph;
 pub mod jobs;
@@ -54,6 +55,8 @@ pub mod stable;
 pub mod stage_timer;
 pub mod studio;
 mod vertex_sets;
+
+pub use file_error::FileError;
 
 /// The README's Rust example, compiled as a doc test so that it cannot rot.
 #[cfg(doctest)]

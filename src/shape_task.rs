@@ -37,14 +37,8 @@ pub enum ShapeTaskError {
         reason: String,
     },
     /// A cache file or directory could not be written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file or directory concerned.
-        path: String,
-        /// The underlying I/O error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
 }
 
 /// What [`compute_shape_entry`] returns: the key and the bytes of both cache entries.
@@ -160,16 +154,20 @@ pub fn store_shape_entry(
     };
     decode_shape_entry(entry, key, vertices).map_err(|r| untrusted(&full, r))?;
     decode_bands_entry(bands_entry, key, vertices).map_err(|r| untrusted(&compact, r))?;
-    std::fs::create_dir_all(cache_dir).map_err(|source| ShapeTaskError::Io {
-        path: cache_dir.display().to_string(),
-        source,
+    std::fs::create_dir_all(cache_dir).map_err(|source| {
+        ShapeTaskError::Io(crate::FileError {
+            path: cache_dir.display().to_string(),
+            source,
+        })
     })?;
     // Full entry first: a crash between the two leaves a valid full entry, from which the
     // compact one is rebuilt on the next read.
     for (path, bytes) in [(&full, entry), (&compact, bands_entry)] {
-        write_atomic(path, |w| w.write_all(bytes)).map_err(|source| ShapeTaskError::Io {
-            path: path.display().to_string(),
-            source,
+        write_atomic(path, |w| w.write_all(bytes)).map_err(|source| {
+            ShapeTaskError::Io(crate::FileError {
+                path: path.display().to_string(),
+                source,
+            })
         })?;
     }
     Ok([full, compact])

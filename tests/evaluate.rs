@@ -8,6 +8,7 @@ use coseg::evaluate::{
     EvaluateError, GroundTruth, ShapeParts, group_parts, part_coverage, part_purity, read_labels,
 };
 use coseg::generate::Family;
+use coseg::labels::LabelError;
 use proptest::prelude::*;
 use std::collections::BTreeMap;
 
@@ -195,7 +196,7 @@ fn read_labels_errors_name_the_file_and_line() {
     std::fs::write(&path, "0\n1\n2.5\n").unwrap();
     let e = read_labels(&path).unwrap_err();
     assert!(
-        matches!(&e, EvaluateError::BadLabel { line: 3, text, .. } if text == "2.5"),
+        matches!(&e, EvaluateError::Label(LabelError::BadLabel { line: 3, text, .. }) if text == "2.5"),
         "{e:?}"
     );
     assert!(e.to_string().contains("bad.labels.txt:3"), "{e}");

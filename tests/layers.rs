@@ -6,10 +6,12 @@
 
 use std::path::Path;
 
-/// Earlier stages first. `vertex_sets` (sorted-set helpers), `labels` (label files) and
+/// Earlier stages first. `file_error` (the I/O error every stage reports) depends on nothing.
+/// `vertex_sets` (sorted-set helpers), `labels` (label files) and
 /// `generate` (synthetic inputs) depend only on `mesh`; `cache` only stores entries;
 /// `stage_timer` (the `COSEG_TIMINGS` profile lines) depends on nothing and every stage uses it.
 const ORDER: &[&str] = &[
+    "file_error",
     "stage_timer",
     "vertex_sets",
     "mesh",

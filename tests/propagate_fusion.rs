@@ -868,7 +868,7 @@ fn the_parts_route_reads_the_parts_coseg_segment_chooses_not_one_part_per_label(
     let (nodes, meshes) = (loaded.nodes, loaded.meshes);
     let mut job = SegmentJob::default();
     job.pipeline = o.pipeline.clone();
-    job.graph = o.graph;
+    job.collection.graph = o.graph;
     let bare = job
         .collection_options(nodes[0].bands.features, o.cache_dir.clone())
         .unwrap();

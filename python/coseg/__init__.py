@@ -328,6 +328,18 @@ def _path(p: Optional[Union[str, os.PathLike]]) -> Optional[str]:
     return None if p is None else os.fspath(p)
 
 
+def _native_options(arguments: Dict[str, Any], *own: str) -> Dict[str, Any]:
+    """The native module's options from a job function's arguments (its ``locals()`` on
+    entry): every keyword under its own name, so that a keyword and its option cannot drift
+    apart, except ``names``, the ``own`` arguments the function converts itself and the
+    per-shape keywords (:func:`_pipeline_opts` converts those); paths as strings."""
+    skip = {"names", "per_shape", *own}
+    opts = {k: v for k, v in arguments.items() if k not in skip}
+    opts["cache_dir"] = _path(opts["cache_dir"])
+    opts["out"] = _path(opts["out"])
+    return opts
+
+
 @_per_shape_keywords()
 def pair(
     shape_a: Any,
@@ -379,31 +391,12 @@ def pair(
 
     {pipeline}
     """
+    opts = _native_options(locals(), "shape_a", "shape_b")
     va, fa, na, xa = _shape(shape_a, "shape a")
     vb, fb, nb, xb = _shape(shape_b, "shape b")
     if names is None:
         names = (na or "shape000", nb or "shape001")
-    opts = dict(
-        algorithm=algorithm,
-        pairs=pairs,
-        alpha=alpha,
-        alpha_of_remaining=alpha_of_remaining,
-        delta_t=delta_t,
-        t_max=t_max,
-        linear_t=linear_t,
-        init=init,
-        seed=seed,
-        max_iterations=max_iterations,
-        refine_rounds=refine_rounds,
-        smoothing_time=smoothing_time,
-        map_weight=map_weight,
-        map_preset=map_preset,
-        map_size=map_size,
-        map_smoothing_time=map_smoothing_time,
-        cache_dir=_path(cache_dir),
-        out=_path(out),
-        **_pipeline_opts(per_shape),
-    )
+    opts.update(_pipeline_opts(per_shape))
     return _coseg.pair([(va, fa), (vb, fb)], list(names), opts, [xa, xb])
 
 
@@ -472,23 +465,9 @@ def segment(
 
     {pipeline}
     """
-    opts = dict(
-        regions=regions,
-        parts=None if parts is None else str(parts),
-        starts=starts,
-        refine_sizes=refine_sizes,
-        parts_from=parts_from,
-        snap_band=snap_band,
-        area_fraction=area_fraction,
-        seed=seed,
-        complete_limit=complete_limit,
-        neighbours=neighbours,
-        refine_rounds=refine_rounds,
-        smoothing_time=smoothing_time,
-        cache_dir=_path(cache_dir),
-        out=_path(out),
-        **_pipeline_opts(dict(per_shape, families=_P["features"] if families is None else families)),
-    )
+    opts = _native_options(locals(), "shapes", "families")
+    opts["parts"] = None if parts is None else str(parts)
+    opts.update(_pipeline_opts(dict(per_shape, families=_P["features"] if families is None else families)))
     if families is None:
         # As `coseg segment` without --features: the library chooses the families.
         opts["features"] = None
@@ -587,21 +566,8 @@ def propagate(
 
     {pipeline}
     """
-    opts = dict(
-        complete_limit=complete_limit,
-        neighbours=neighbours,
-        smoothing_time=smoothing_time,
-        max_sweeps=max_sweeps,
-        network_weight=network_weight,
-        similarity_power=similarity_power,
-        size_prior=size_prior,
-        area_weighted=area_weighted,
-        map_step=map_step,
-        map_agreement=map_agreement,
-        cache_dir=_path(cache_dir),
-        out=_path(out),
-        **_pipeline_opts(per_shape),
-    )
+    opts = _native_options(locals(), "shapes", "labels", "part_names")
+    opts.update(_pipeline_opts(per_shape))
     if isinstance(part_names, (str, os.PathLike)):
         opts["part_names"] = os.fspath(part_names)
     elif part_names is not None:

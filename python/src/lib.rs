@@ -353,6 +353,60 @@ fn shapes_from(
     Ok(out)
 }
 
+/// The shapes of a list as a job's input.
+fn job_shapes(
+    list: &Bound<'_, PyList>,
+    names: Option<Vec<String>>,
+    files: Option<Vec<Option<String>>>,
+) -> PyResult<Vec<JobShape>> {
+    Ok(shapes_from(list, names, files)?
+        .into_iter()
+        .map(Shape::into_job_shape)
+        .collect())
+}
+
+/// The cache a job uses: `cache_dir` when given; otherwise a folder's, beside the output as the
+/// CLI's (`CacheChoice::Auto`), and none for shapes given as a list.
+fn cache_choice(cache_dir: Option<PathBuf>, folder: bool) -> CacheChoice {
+    match (cache_dir, folder) {
+        (Some(dir), _) => CacheChoice::Dir(dir),
+        (None, true) => CacheChoice::Auto,
+        (None, false) => CacheChoice::Off,
+    }
+}
+
+/// One numpy array per shape.
+fn arrays<'py, T: numpy::Element + Clone>(
+    py: Python<'py>,
+    per_shape: &[Vec<T>],
+) -> Vec<Bound<'py, PyArray1<T>>> {
+    per_shape
+        .iter()
+        .map(|a| PyArray1::from_slice(py, a))
+        .collect()
+}
+
+/// What every collection job returns besides its own results: `summary` (summary.json's
+/// content), `skipped`, `warnings`, `outcomes` (per shape, where its data came from) and
+/// `written`.
+fn set_run_report<'py>(
+    d: &Bound<'py, PyDict>,
+    summary: &impl serde::Serialize,
+    skipped: &[SkippedInput],
+    warnings: &[String],
+    cache_outcomes: &[Option<CacheOutcome>],
+    written: &[PathBuf],
+) -> PyResult<()> {
+    let py = d.py();
+    d.set_item("summary", json(py, summary)?)?;
+    d.set_item("skipped", json(py, &skipped)?)?;
+    d.set_item("warnings", warnings.to_vec())?;
+    let outcomes: Vec<&str> = cache_outcomes.iter().map(outcome_name).collect();
+    d.set_item("outcomes", outcomes)?;
+    d.set_item("written", written.to_vec())?;
+    Ok(())
+}
+
 /// Pair stage: `{"labels_a", "labels_b", "summary", "written"}`.
 #[pyfunction]
 #[pyo3(signature = (shapes, names=None, options=None, files=None))]
@@ -379,7 +433,7 @@ fn pair<'py>(
     let mut job = PairJob::default();
     job.pipeline = pipe;
     job.pair = pair_opts.options();
-    job.cache = cache.map_or(CacheChoice::Off, CacheChoice::Dir);
+    job.cache = cache_choice(cache, false);
     job.output = out_dir;
     // Python returns arrays; pictures are `coseg.render`'s.
     job.pictures = false;
@@ -429,31 +483,26 @@ fn segment<'py>(
     o.finish()?;
     // Python returns arrays; pictures are `coseg.render`'s.
     job.pictures = false;
-    let input = if let Ok(list) = shapes.cast::<PyList>() {
-        job.cache = cache.map_or(CacheChoice::Off, CacheChoice::Dir);
-        let shapes = shapes_from(list, names, files)?;
-        SegmentInput::Shapes(shapes.into_iter().map(Shape::into_job_shape).collect())
-    } else {
-        job.cache = cache.map_or(CacheChoice::Auto, CacheChoice::Dir);
-        SegmentInput::Folder(shapes.extract()?)
+    let list = shapes.cast::<PyList>().ok();
+    job.cache = cache_choice(cache, list.is_none());
+    let input = match list {
+        Some(list) => SegmentInput::Shapes(job_shapes(list, names, files)?),
+        None => SegmentInput::Folder(shapes.extract()?),
     };
     let outcome = py
         .detach(|| run_segment(input, &job))
         .map_err(|e| lib_err(&e))?;
     let d = PyDict::new(py);
     d.set_item("names", outcome.result.segmentation.names.clone())?;
-    let arrays: Vec<Bound<PyArray1<i32>>> = outcome
-        .labels
-        .iter()
-        .map(|l| PyArray1::from_slice(py, l))
-        .collect();
-    d.set_item("labels", arrays)?;
-    d.set_item("summary", json(py, &outcome.summary)?)?;
-    d.set_item("skipped", json(py, &outcome.skipped)?)?;
-    d.set_item("warnings", outcome.warnings.clone())?;
-    let outcomes: Vec<&str> = outcome.cache_outcomes.iter().map(outcome_name).collect();
-    d.set_item("outcomes", outcomes)?;
-    d.set_item("written", outcome.written.clone())?;
+    d.set_item("labels", arrays(py, &outcome.labels))?;
+    set_run_report(
+        &d,
+        &outcome.summary,
+        &outcome.skipped,
+        &outcome.warnings,
+        &outcome.cache_outcomes,
+        &outcome.written,
+    )?;
     Ok(d)
 }
 
@@ -503,62 +552,50 @@ fn propagate<'py>(
     o.finish()?;
     // Python returns arrays; pictures are `coseg.render`'s.
     job.pictures = false;
-    let input = if let Ok(list) = shapes.cast::<PyList>() {
-        job.cache = cache.map_or(CacheChoice::Off, CacheChoice::Dir);
-        PropagateInput::Shapes {
-            shapes: shapes_from(list, names, files)?
-                .into_iter()
-                .map(Shape::into_job_shape)
-                .collect(),
+    let list = shapes.cast::<PyList>().ok();
+    job.cache = cache_choice(cache, list.is_none());
+    let input = match list {
+        Some(list) => PropagateInput::Shapes {
+            shapes: job_shapes(list, names, files)?,
             labels: label_inputs(&labels)?,
             part_names: names_map.unwrap_or_default(),
-        }
-    } else {
-        if names_map.is_some() {
+        },
+        None if names_map.is_some() => {
             return Err(input_err(
                 "part names of a folder come from a file (part_names=PATH)",
             ));
         }
-        job.cache = cache.map_or(CacheChoice::Auto, CacheChoice::Dir);
-        PropagateInput::Folder {
+        None => PropagateInput::Folder {
             folder: shapes.extract()?,
             labels: labels.extract()?,
-        }
+        },
     };
     let outcome = py
         .detach(|| run_propagate(input, &job))
         .map_err(|e| lib_err(&e))?;
     let (result, summary) = (&outcome.result, &outcome.summary);
-    let outcomes: Vec<&str> = outcome.cache_outcomes.iter().map(outcome_name).collect();
     let p = &result.propagation;
     let n = result.graph.node_count();
     let d = PyDict::new(py);
     let names: Vec<String> = (0..n).map(|i| result.graph.node(i).name.clone()).collect();
     d.set_item("names", names)?;
-    let labels: Vec<Bound<PyArray1<i32>>> = p
-        .labels
-        .iter()
-        .map(|l| PyArray1::from_slice(py, l))
-        .collect();
-    d.set_item("labels", labels)?;
-    let confidence: Vec<Bound<PyArray1<f64>>> = p
-        .confidence
-        .iter()
-        .map(|c| PyArray1::from_slice(py, c))
-        .collect();
-    d.set_item("confidence", confidence)?;
+    d.set_item("labels", arrays(py, &p.labels))?;
+    d.set_item("confidence", arrays(py, &p.confidence))?;
     d.set_item("parts", p.parts.clone())?;
     d.set_item(
         "shape_confidence",
         PyArray1::from_slice(py, &p.shape_confidence),
     )?;
     d.set_item("sources", summary.sources.clone())?;
-    d.set_item("summary", json(py, summary)?)?;
     let skipped: Vec<SkippedInput> = result.skipped.iter().map(SkippedInput::from).collect();
-    d.set_item("skipped", json(py, &skipped)?)?;
-    d.set_item("warnings", result.warnings.clone())?;
-    d.set_item("outcomes", outcomes)?;
-    d.set_item("written", outcome.written.clone())?;
+    set_run_report(
+        &d,
+        summary,
+        &skipped,
+        &result.warnings,
+        &outcome.cache_outcomes,
+        &outcome.written,
+    )?;
     Ok(d)
 }
 

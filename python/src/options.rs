@@ -4,15 +4,13 @@
 
 use coseg::bands::BandWeighting;
 use coseg::features::FeatureError;
-use coseg::graph::{GraphError, GraphOptions, RefineSizes};
+use coseg::graph::GraphOptions;
 use coseg::jobs::SegmentJob;
 use coseg::maps::{MapOverrides, MapPreset, MapStep};
-use coseg::parts::{PartsFrom, PartsRequest};
 use coseg::pipeline::{FamilyFlags, ShapePipelineOptions};
 use coseg::propagate::{MapStepOptions, PropagateOptions};
 use coseg::stable::{
-    Algorithm, AreaReference, Init, RefineOptions, SegmentPairOptions, StableRegionsOptions,
-    TSearch, Threshold,
+    AreaReference, RefineOptions, SegmentPairOptions, StableRegionsOptions, TSearch, Threshold,
 };
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
@@ -39,6 +37,18 @@ impl<'py> Opts<'py> {
             let e: PyErr = e.into();
             super::input_err(format!("option {key}: {e}"))
         })
+    }
+
+    /// Removes `key`, a string, and parses it with the library's parser (`FromStr`, the names
+    /// the CLI's flags take); `None` when absent or `None`.
+    pub fn parse<T: std::str::FromStr>(&mut self, key: &str) -> PyResult<Option<T>>
+    where
+        T::Err: std::fmt::Display,
+    {
+        self.take::<String>(key)?
+            .map(|v| v.parse::<T>())
+            .transpose()
+            .map_err(|e| super::input_err(format!("option {key}: {e}")))
     }
 
     /// Removes `key` and, when present and not `None`, converts it into `field`; an absent key
@@ -126,7 +136,6 @@ impl<'py> Opts<'py> {
     /// The segment job, as `coseg segment` sets it: the per-shape options, and the families
     /// chosen from the data unless `features` is given.
     pub fn segment(&mut self) -> PyResult<SegmentJob> {
-        let lib = |e: GraphError| super::lib_err(&e);
         let mut job = SegmentJob::default();
         job.choose_features = match &self.0 {
             Some(d) => !d.get_item("features")?.is_some_and(|v| !v.is_none()),
@@ -134,26 +143,21 @@ impl<'py> Opts<'py> {
         };
         job.pipeline = self.pipeline()?;
         job.regions = self.take("regions")?;
-        job.parts = self
-            .take::<String>("parts")?
-            .map(|p| p.parse::<PartsRequest>())
-            .transpose()
-            .map_err(lib)?;
-        job.parts_from = self
-            .take::<String>("parts_from")?
-            .map(|f| f.parse::<PartsFrom>())
-            .transpose()
-            .map_err(lib)?;
+        job.parts = self.parse("parts")?;
+        job.parts_from = self.parse("parts_from")?;
         job.snap_band = self.take("snap_band")?;
-        job.area_fraction = self.take("area_fraction")?;
-        job.seed = self.take("seed")?;
-        self.set("complete_limit", &mut job.graph.complete_limit)?;
-        self.set("neighbours", &mut job.graph.neighbours)?;
-        self.set("refine_rounds", &mut job.refine_rounds)?;
-        self.set("smoothing_time", &mut job.smoothing_time)?;
-        self.set("starts", &mut job.starts)?;
-        if let Some(r) = self.take::<String>("refine_sizes")? {
-            job.refine_sizes = r.parse::<RefineSizes>().map_err(lib)?;
+        let c = &mut job.collection;
+        c.cosegment.area_fraction = self.take("area_fraction")?;
+        c.cosegment.seed = self.take("seed")?;
+        self.set("complete_limit", &mut c.graph.complete_limit)?;
+        self.set("neighbours", &mut c.graph.neighbours)?;
+        let (mut rounds, mut time) = RefineOptions::rounds_of(c.refine.as_ref());
+        self.set("refine_rounds", &mut rounds)?;
+        self.set("smoothing_time", &mut time)?;
+        c.refine = RefineOptions::rounds(rounds, time);
+        self.set("starts", &mut c.starts)?;
+        if let Some(r) = self.parse("refine_sizes")? {
+            c.refine_sizes = r;
         }
         Ok(job)
     }
@@ -161,12 +165,8 @@ impl<'py> Opts<'py> {
     /// The pair stage's options, as `coseg pair` sets them.
     pub fn pair(&mut self) -> PyResult<PairOpts> {
         let mut r = StableRegionsOptions::default();
-        if let Some(a) = self.take::<String>("algorithm")? {
-            r.algorithm = match a.as_str() {
-                "fixed" => Algorithm::Fixed,
-                "auto" => Algorithm::Auto,
-                _ => return Err(bad("algorithm", &a, "fixed, auto")),
-            };
+        if let Some(a) = self.parse("algorithm")? {
+            r.algorithm = a;
         }
         self.set("pairs", &mut r.pairs)?;
         if let Some(a) = self.take::<f64>("alpha")? {
@@ -181,12 +181,8 @@ impl<'py> Opts<'py> {
         if self.take::<bool>("linear_t")? == Some(true) {
             r.t_search = TSearch::Linear;
         }
-        if let Some(a) = self.take::<String>("init")? {
-            r.init = match a.as_str() {
-                "extreme" => Init::Extreme,
-                "random" => Init::Random,
-                _ => return Err(bad("init", &a, "extreme, random")),
-            };
+        if let Some(a) = self.parse("init")? {
+            r.init = a;
         }
         self.set("seed", &mut r.seed)?;
         self.set("max_iterations", &mut r.max_iterations)?;
@@ -201,12 +197,7 @@ impl<'py> Opts<'py> {
         };
         Ok(PairOpts {
             regions: r,
-            refine: (rounds > 0).then_some({
-                let mut opts = RefineOptions::default();
-                opts.max_rounds = rounds;
-                opts.smoothing_time = time;
-                opts
-            }),
+            refine: RefineOptions::rounds(rounds, time),
             preset,
             map_weight: self.take("map_weight")?,
             map_size: self.take("map_size")?,

@@ -69,20 +69,13 @@ pub fn run(args: AlignArgs) -> Result<ExitCode> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::Parser;
-
-    #[derive(Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: AlignArgs,
-    }
 
     /// The bare command runs the job's default: the CLI chooses no default of its own.
     #[test]
     fn the_bare_command_runs_the_default_job() {
-        let cli = Cli::parse_from(["coseg", "shapes", "-o", "out"]);
+        let args: AlignArgs = super::super::parse_args(&["coseg", "shapes", "-o", "out"]);
         let mut want = AlignJob::default();
         want.output = Some(PathBuf::from("out"));
-        assert_eq!(align_job(&cli.args), want);
+        assert_eq!(align_job(&args), want);
     }
 }

@@ -62,6 +62,13 @@ struct GlobalArgs {
     threads: Option<u16>,
 }
 
+/// One subcommand's flags parsed alone from `argv`: its tests check what they translate into.
+#[cfg(test)]
+fn parse_args<A: Args>(argv: &[&str]) -> A {
+    let command = A::augment_args(clap::Command::new("coseg"));
+    clap::FromArgMatches::from_arg_matches(&command.get_matches_from(argv)).unwrap()
+}
+
 #[derive(Debug, Subcommand)]
 enum Command {
     /// Load meshes, validate them and print their counts and warnings.

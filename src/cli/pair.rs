@@ -235,12 +235,7 @@ fn pair_job(args: &PairArgs) -> Result<PairJob> {
 fn segment_pair_options(args: &PairArgs) -> SegmentPairOptions {
     let mut opts = SegmentPairOptions::default();
     opts.regions = region_options(args);
-    opts.refine = (args.refine_rounds > 0).then(|| {
-        let mut refine = RefineOptions::default();
-        refine.max_rounds = args.refine_rounds;
-        refine.smoothing_time = args.smoothing_time;
-        refine
-    });
+    opts.refine = RefineOptions::rounds(args.refine_rounds, args.smoothing_time);
     opts.map_step = map_step(args);
     opts.map_after_refine = args.map_after_refine;
     opts

@@ -177,19 +177,13 @@ pub fn run(args: PropagateArgs) -> Result<ExitCode> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::Parser;
-
-    #[derive(Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: PropagateArgs,
-    }
 
     /// The bare command runs the job's default: the CLI chooses no default of its own.
     #[test]
     fn the_bare_command_runs_the_default_job() {
-        let cli = Cli::parse_from(["coseg", "shapes", "--labels", "a.seg", "-o", "out"]);
-        let job = propagate_job(&cli.args).unwrap();
+        let args: PropagateArgs =
+            super::super::parse_args(&["coseg", "shapes", "--labels", "a.seg", "-o", "out"]);
+        let job = propagate_job(&args).unwrap();
         let mut want = PropagateJob::default();
         want.output = Some(PathBuf::from("out"));
         want.pictures = true;

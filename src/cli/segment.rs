@@ -8,6 +8,7 @@ use coseg::jobs::{
     JobError, SegmentInput, SegmentJob, SegmentOutcome, SegmentProgress, run_segment_with_progress,
 };
 use coseg::parts::{PartsFrom, PartsRequest};
+use coseg::stable::RefineOptions;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -57,18 +58,18 @@ pub struct SegmentArgs {
     /// Co-segment from this many starts (the default start, then seeded ones) and keep the one
     /// with the highest mean region confidence; equal-area mode only (an error with
     /// `--parts`). See docs/PARTS.md.
-    #[arg(long, default_value_t = SegmentJob::default().starts)]
+    #[arg(long, default_value_t = SegmentJob::default().collection.starts)]
     starts: usize,
     /// Collections up to this size use a complete shape graph; larger ones a nearest-neighbour
     /// graph.
-    #[arg(long, default_value_t = SegmentJob::default().graph.complete_limit)]
+    #[arg(long, default_value_t = SegmentJob::default().collection.graph.complete_limit)]
     complete_limit: usize,
     /// Neighbours per shape of the nearest-neighbour graph.
-    #[arg(long, default_value_t = SegmentJob::default().graph.neighbours)]
+    #[arg(long, default_value_t = SegmentJob::default().collection.graph.neighbours)]
     neighbours: usize,
     /// Sweeps of boundary refinement after the co-segmentation (smoothed best responses over
     /// every graph edge, see `coseg::graph::refine_cosegmentation`); 0 keeps the raw regions.
-    #[arg(long, default_value_t = SegmentJob::default().refine_rounds)]
+    #[arg(long, default_value_t = default_refine().0)]
     refine_rounds: usize,
     /// How the refinement treats part sizes: `free` (default: the classic best response,
     /// which drifts towards equal areas), `keep` (each part's area on each shape stays within
@@ -78,10 +79,15 @@ pub struct SegmentArgs {
     #[arg(long, value_parser = parse_refine_sizes)]
     refine_sizes: Option<RefineSizes>,
     /// Heat-smoothing time of the refinement (unit-area surface; 0 = no smoothing).
-    #[arg(long, default_value_t = SegmentJob::default().smoothing_time)]
+    #[arg(long, default_value_t = default_refine().1)]
     smoothing_time: f64,
     #[command(flatten)]
     pipeline: super::pipeline_args::PipelineArgs,
+}
+
+/// The default job's refinement as `--refine-rounds` and `--smoothing-time` show it.
+fn default_refine() -> (usize, f64) {
+    RefineOptions::rounds_of(SegmentJob::default().collection.refine.as_ref())
 }
 
 /// `--refine-sizes free|keep[:TOL]`.
@@ -108,15 +114,15 @@ fn segment_job(args: &SegmentArgs) -> Result<SegmentJob> {
     job.parts = args.parts;
     job.parts_from = args.parts_from;
     job.snap_band = args.snap_band;
-    job.area_fraction = args.area_fraction;
-    job.seed = args.seed;
-    job.starts = args.starts;
-    job.graph.complete_limit = args.complete_limit;
-    job.graph.neighbours = args.neighbours;
-    job.refine_rounds = args.refine_rounds;
-    job.smoothing_time = args.smoothing_time;
+    let c = &mut job.collection;
+    c.cosegment.area_fraction = args.area_fraction;
+    c.cosegment.seed = args.seed;
+    c.starts = args.starts;
+    c.graph.complete_limit = args.complete_limit;
+    c.graph.neighbours = args.neighbours;
+    c.refine = RefineOptions::rounds(args.refine_rounds, args.smoothing_time);
     if let Some(r) = args.refine_sizes {
-        job.refine_sizes = r;
+        c.refine_sizes = r;
     }
     job.cache = super::cache_or_auto(&args.cache);
     job.output = Some(args.out.clone());
@@ -288,21 +294,14 @@ fn report(args: &SegmentArgs, outcome: &SegmentOutcome, t0: Instant) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use clap::Parser;
-
-    #[derive(Parser)]
-    struct Cli {
-        #[command(flatten)]
-        args: SegmentArgs,
-    }
 
     /// The bare command runs the job's default: the CLI chooses no default of its own.
     #[test]
     fn the_bare_command_runs_the_default_job() {
-        let cli = Cli::parse_from(["coseg", "shapes", "-o", "out"]);
+        let args: SegmentArgs = super::super::parse_args(&["coseg", "shapes", "-o", "out"]);
         let mut want = SegmentJob::default();
         want.output = Some(PathBuf::from("out"));
         want.pictures = true;
-        assert_eq!(segment_job(&cli.args).unwrap(), want);
+        assert_eq!(segment_job(&args).unwrap(), want);
     }
 }

@@ -1,6 +1,7 @@
 //! [`evaluate_folder`]: scores a folder written by `coseg segment`, `pair` or `propagate`
 //! against a ground-truth folder (what `coseg eval` prints).
 
+use super::label_agreement::finite_face_areas;
 use super::{EvaluateError, LabelAgreement, label_agreement, matched_scores, read_labels};
 use crate::labels::{faces_to_vertices, vertices_to_faces};
 use crate::mesh::{TriMesh, read_mesh};
@@ -108,7 +109,7 @@ pub fn evaluate_folder(
 ) -> Result<FolderScores, EvaluateError> {
     let io = |path: &Path| {
         let path = path.display().to_string();
-        move |source| EvaluateError::Io { path, source }
+        move |source| EvaluateError::Io(crate::FileError { path, source })
     };
     let mut stems: BTreeMap<ResultKind, Vec<String>> = BTreeMap::new();
     for entry in std::fs::read_dir(result).map_err(io(result))? {
@@ -272,12 +273,7 @@ impl Truth {
         match (&self.faces, &self.vertex_areas) {
             (Some((mesh, faces)), _) => {
                 let predicted = vertices_to_faces(mesh, found).map_err(shape_error)?;
-                let areas: Vec<f64> = mesh
-                    .face_areas()
-                    .into_iter()
-                    .map(|a| if a.is_finite() { a } else { 0.0 })
-                    .collect();
-                label_agreement(&areas, faces, &predicted)
+                label_agreement(&finite_face_areas(mesh), faces, &predicted)
             }
             (None, Some(areas)) => label_agreement(areas, &self.vertices, found),
             // Without a mesh every vertex weighs the same.

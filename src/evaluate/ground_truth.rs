@@ -34,9 +34,11 @@ impl GroundTruth {
             path: path.display().to_string(),
             message,
         };
-        let text = std::fs::read_to_string(&path).map_err(|source| EvaluateError::Io {
-            path: path.display().to_string(),
-            source,
+        let text = std::fs::read_to_string(&path).map_err(|source| {
+            EvaluateError::Io(crate::FileError {
+                path: path.display().to_string(),
+                source,
+            })
         })?;
         let manifest: Manifest = serde_json::from_str(&text).map_err(|e| bad(e.to_string()))?;
         let groups = group_parts(&manifest.parts, &manifest.part_groups).map_err(|e| match e {

@@ -155,12 +155,16 @@ pub fn face_label_agreement(
             ),
         });
     }
-    let areas: Vec<f64> = mesh
-        .face_areas()
+    label_agreement(&finite_face_areas(mesh), truth_faces, &faces)
+}
+
+/// The weights of per-face scores: each face's area, 0 for a face whose area is not finite (a
+/// degenerate face counts for nothing rather than spoiling every score).
+pub(super) fn finite_face_areas(mesh: &TriMesh) -> Vec<f64> {
+    mesh.face_areas()
         .into_iter()
         .map(|a| if a.is_finite() { a } else { 0.0 })
-        .collect();
-    label_agreement(&areas, truth_faces, &faces)
+        .collect()
 }
 
 /// Per-vertex scores of per-vertex predictions against per-vertex truth, weighted by the

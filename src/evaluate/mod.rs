@@ -51,6 +51,7 @@ pub use part_purity::part_purity;
 pub use rand_index::rand_index;
 pub use read_labels::{parse_labels, read_labels};
 
+use crate::labels::LabelError;
 use crate::mesh::TriMesh;
 use std::collections::BTreeMap;
 use thiserror::Error;
@@ -59,24 +60,12 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum EvaluateError {
     /// A file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
-    },
-    /// A line of a label file is not an integer (`line` is 1-based).
-    #[error("{path}:{line}: {text:?} is not an integer label")]
-    BadLabel {
-        /// The file.
-        path: String,
-        /// 1-based line number.
-        line: usize,
-        /// The offending text.
-        text: String,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
+    /// A line of a label file is not an integer ([`LabelError::BadLabel`]: the label files'
+    /// one parser serves both modules).
+    #[error(transparent)]
+    Label(LabelError),
     /// A manifest could not be parsed or is inconsistent.
     #[error("{path}: {message}")]
     BadManifest {

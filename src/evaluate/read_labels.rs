@@ -42,8 +42,8 @@ pub fn parse_labels(bytes: &[u8], name: &str) -> Result<Vec<i32>, EvaluateError>
 /// The label module's error (one parser of label files serves both) as this module's.
 fn evaluate_error(e: LabelError, path: &Path) -> EvaluateError {
     match e {
-        LabelError::Io { path, source } => EvaluateError::Io { path, source },
-        LabelError::BadLabel { path, line, text } => EvaluateError::BadLabel { path, line, text },
+        LabelError::Io(e) => EvaluateError::Io(e),
+        e @ LabelError::BadLabel { .. } => EvaluateError::Label(e),
         e => EvaluateError::BadManifest {
             path: path.display().to_string(),
             message: e.to_string(),

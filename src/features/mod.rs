@@ -80,14 +80,8 @@ pub enum FeatureError {
         message: String,
     },
     /// A file could not be written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file concerned.
-        path: String,
-        /// The underlying I/O error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
     /// Descriptor and band tables do not describe the same vertices/features.
     #[error("inconsistent tables: {0}")]
     Inconsistent(String),

@@ -208,12 +208,6 @@ pub enum GenerateError {
     #[error("invalid options: {0}")]
     Options(String),
     /// Writing a file failed.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file concerned.
-        path: String,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
 }

@@ -150,7 +150,7 @@ pub fn write_collection(
 ) -> Result<(), GenerateError> {
     let io = |path: &Path| {
         let path = path.display().to_string();
-        move |source| GenerateError::Io { path, source }
+        move |source| GenerateError::Io(crate::FileError { path, source })
     };
     std::fs::create_dir_all(dir).map_err(io(dir))?;
     for shape in &collection.shapes {

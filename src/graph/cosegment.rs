@@ -53,10 +53,8 @@ use super::stable_cycle::{CycleShape, CycleStep};
 use super::{GraphError, cycle_consistency};
 use crate::affinity::BandAffinity;
 use crate::affinity::kernel::row_sum;
-use crate::stable::{Threshold, threshold};
+use crate::stable::{Threshold, most_extreme_vertex, random_half, threshold};
 use crate::vertex_sets::{intersect_sorted, remove_sorted};
-use rand_chacha::ChaCha8Rng;
-use rand_chacha::rand_core::{Rng, SeedableRng};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -746,38 +744,10 @@ pub(crate) fn seed_region(
     index: usize,
 ) -> Vec<u32> {
     match seed {
-        None => {
-            let t = &graph.node(root).bands;
-            let k1 = t.bands as i64 - 1;
-            let mut best: Option<(i64, u32)> = None;
-            for &p in rem {
-                let s: i64 = t
-                    .row(p as usize)
-                    .iter()
-                    .map(|&l| (2 * l as i64 - k1).abs())
-                    .sum();
-                if best.is_none_or(|(bs, _)| s > bs) {
-                    best = Some((s, p));
-                }
-            }
-            best.map(|(_, p)| vec![p]).unwrap_or_default()
-        }
-        Some(s) => {
-            let mut rng = ChaCha8Rng::seed_from_u64(
-                s ^ (index as u64 + 1).wrapping_mul(0x9E37_79B9_7F4A_7C15),
-            );
-            let mut out = Vec::with_capacity(rem.len() / 2 + 1);
-            let mut bits = 0u64;
-            for (i, &v) in rem.iter().enumerate() {
-                if i % 64 == 0 {
-                    bits = rng.next_u64();
-                }
-                if (bits >> (i % 64)) & 1 == 1 {
-                    out.push(v);
-                }
-            }
-            out
-        }
+        None => most_extreme_vertex(&graph.node(root).bands, rem)
+            .map(|p| vec![p])
+            .unwrap_or_default(),
+        Some(s) => random_half(rem, s, index),
     }
 }
 

@@ -75,9 +75,11 @@ pub fn is_coseg_output(path: &Path) -> bool {
 
 /// The mesh files of `folder` (sorted) and, apart, the coseg outputs among them (sorted).
 fn list_mesh_files(folder: &Path) -> Result<(Vec<PathBuf>, Vec<PathBuf>), GraphError> {
-    let io = |source| GraphError::Io {
-        path: folder.display().to_string(),
-        source,
+    let io = |source| {
+        GraphError::Io(crate::FileError {
+            path: folder.display().to_string(),
+            source,
+        })
     };
     let (mut keep, mut ignored) = (Vec::new(), Vec::new());
     for entry in std::fs::read_dir(folder).map_err(io)? {

@@ -76,12 +76,6 @@ pub enum GraphError {
         source: crate::features::FeatureError,
     },
     /// The collection folder could not be listed.
-    #[error("{path}: {source}")]
-    Io {
-        /// The folder.
-        path: String,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
 }

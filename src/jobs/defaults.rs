@@ -10,7 +10,7 @@ use crate::pipeline::{FamilyFlags, ShapePipelineOptions};
 use crate::propagate::PartScore;
 use crate::render::RenderOptions;
 use crate::spectral::SpectrumOptions;
-use crate::stable::{AreaReference, Init, TSearch, Threshold};
+use crate::stable::{AreaReference, Init, RefineOptions, TSearch, Threshold};
 use serde_json::{Value, json};
 
 /// The library's default of every option the command line and the Python package expose, as a
@@ -63,6 +63,8 @@ fn pipeline() -> Value {
 
 fn segment() -> Value {
     let j = SegmentJob::default();
+    let c = &j.collection;
+    let (refine_rounds, smoothing_time) = RefineOptions::rounds_of(c.refine.as_ref());
     json!({
         "regions": j.regions,
         "parts": j.parts.map(|p| match p {
@@ -74,14 +76,14 @@ fn segment() -> Value {
             crate::parts::PartsFrom::Geometry { .. } => "geometry",
         }),
         "snap_band": j.snap_band,
-        "area_fraction": j.area_fraction,
-        "seed": j.seed,
-        "starts": j.starts,
-        "complete_limit": j.graph.complete_limit,
-        "neighbours": j.graph.neighbours,
-        "refine_rounds": j.refine_rounds,
-        "smoothing_time": j.smoothing_time,
-        "refine_sizes": match j.refine_sizes {
+        "area_fraction": c.cosegment.area_fraction,
+        "seed": c.cosegment.seed,
+        "starts": c.starts,
+        "complete_limit": c.graph.complete_limit,
+        "neighbours": c.graph.neighbours,
+        "refine_rounds": refine_rounds,
+        "smoothing_time": smoothing_time,
+        "refine_sizes": match c.refine_sizes {
             RefineSizes::Free => "free".to_string(),
             RefineSizes::Keep { tolerance } => format!("keep:{tolerance}"),
         },

@@ -30,9 +30,11 @@ pub fn run_eval(result: &Path, truth: &Path, job: &EvalJob) -> Result<FolderScor
         let text = serde_json::to_string_pretty(&scores)
             .map_err(|e| JobError::Invalid(format!("scores as JSON: {e}")))?;
         crate::mesh::write_atomic(path, |w| std::io::Write::write_all(w, text.as_bytes()))
-            .map_err(|source| crate::output::OutputError::Io {
-                path: path.display().to_string(),
-                source,
+            .map_err(|source| {
+                crate::output::OutputError::Io(crate::FileError {
+                    path: path.display().to_string(),
+                    source,
+                })
             })?;
     }
     Ok(scores)

@@ -3,13 +3,12 @@
 
 use super::{CacheChoice, JobError, JobShape, LoadedNodes, load_nodes};
 use crate::cache::CacheOutcome;
-use crate::graph::{GraphOptions, RefineSizes, load_collection};
+use crate::graph::load_collection;
 use crate::mesh::TriMesh;
 use crate::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
 use crate::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentedCollection};
 use crate::pipeline::ShapePipelineOptions;
 use crate::render::{RenderOptions, RenderShape};
-use crate::stable::RefineOptions;
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -27,7 +26,8 @@ pub enum SegmentInput {
 /// their number and the feature families chosen from the data.
 ///
 /// The mode fields ([`SegmentJob::regions`], [`SegmentJob::parts`], [`SegmentJob::parts_from`])
-/// are read as [`SegmentCollectionOptions::for_request`] reads them.
+/// are read as [`SegmentCollectionOptions::for_request`] reads them; they set the mode of
+/// [`SegmentJob::collection`], which holds every other option of the collection stage.
 #[derive(Debug, Clone, PartialEq)]
 #[non_exhaustive]
 pub struct SegmentJob {
@@ -47,22 +47,12 @@ pub struct SegmentJob {
     /// How far a part boundary may move onto a concave crease, × √(shape area), with parts from
     /// geometry (default `None`: the parts' own band).
     pub snap_band: Option<f64>,
-    /// Area of each region as a fraction of its shape (default `None`: 1 / regions).
-    pub area_fraction: Option<f64>,
-    /// Start each region from a seeded random half of the root shape (default `None`: from its
-    /// most distinctive vertex).
-    pub seed: Option<u64>,
-    /// Co-segmentation starts ([`SegmentCollectionOptions::starts`]).
-    pub starts: usize,
-    /// The shape graph (default [`GraphOptions::default`]).
-    pub graph: GraphOptions,
-    /// Sweeps of boundary refinement (0 keeps the raw regions; default: the collection's
-    /// default refinement, [`SegmentCollectionOptions::default`]).
-    pub refine_rounds: usize,
-    /// Heat-smoothing time of the refinement (unit-area surface; default: the collection's).
-    pub smoothing_time: f64,
-    /// How the refinement treats part sizes (default [`RefineSizes::Free`]).
-    pub refine_sizes: RefineSizes,
+    /// The collection stage (default [`SegmentCollectionOptions::default`]): the shape graph,
+    /// the co-segmentation (its area fraction, and its seed, which seeds the parts' tuples
+    /// too), the starts, the boundary refinement and how it treats part sizes. Its mode
+    /// (`cosegment.regions`, `parts`, `parts_from`) is the mode fields', its feature options
+    /// the pipeline's ([`SegmentCollectionOptions::set_pipeline`]).
+    pub collection: SegmentCollectionOptions,
     /// The per-shape cache (default [`CacheChoice::Auto`]: `<output>/.cache`; with no output,
     /// a folder uses `<folder>/.cache` and shapes in memory are computed without a cache).
     /// The part cues of parts from geometry are kept there too.
@@ -81,8 +71,6 @@ pub struct SegmentJob {
 
 impl Default for SegmentJob {
     fn default() -> Self {
-        let collection = SegmentCollectionOptions::default();
-        let refine = collection.refine.clone().unwrap_or_default();
         Self {
             pipeline: ShapePipelineOptions::default(),
             choose_features: true,
@@ -90,13 +78,7 @@ impl Default for SegmentJob {
             parts: None,
             parts_from: None,
             snap_band: None,
-            area_fraction: None,
-            seed: None,
-            starts: collection.starts,
-            graph: collection.graph,
-            refine_rounds: refine.max_rounds,
-            smoothing_time: refine.smoothing_time,
-            refine_sizes: collection.refine_sizes,
+            collection: SegmentCollectionOptions::default(),
             cache: CacheChoice::Auto,
             output: None,
             pictures: false,
@@ -107,7 +89,7 @@ impl Default for SegmentJob {
 
 impl SegmentJob {
     /// The collection stage's options for nodes of `columns` feature columns, the part cues
-    /// kept in `cue_cache`.
+    /// kept in `cue_cache`: [`SegmentJob::collection`] in the mode the mode fields select.
     ///
     /// Errors: [`JobError::Graph`] for a snap band without parts from geometry.
     pub fn collection_options(
@@ -115,20 +97,14 @@ impl SegmentJob {
         columns: usize,
         cue_cache: Option<PathBuf>,
     ) -> Result<SegmentCollectionOptions, JobError> {
-        let mut o =
-            SegmentCollectionOptions::for_request(self.regions, self.parts, self.parts_from);
-        o.graph = self.graph;
-        o.cosegment.area_fraction = self.area_fraction;
-        o.cosegment.seed = self.seed;
-        o.refine = (self.refine_rounds > 0).then_some(RefineOptions {
-            max_rounds: self.refine_rounds,
-            smoothing_time: self.smoothing_time,
-        });
-        o.starts = self.starts;
-        o.refine_sizes = self.refine_sizes;
+        let mode = SegmentCollectionOptions::for_request(self.regions, self.parts, self.parts_from);
+        let mut o = self.collection.clone();
+        o.cosegment.regions = mode.cosegment.regions;
+        o.parts = mode.parts;
+        o.parts_from = mode.parts_from;
         o.set_pipeline(&self.pipeline, !self.choose_features, columns);
         if let Some(p) = o.parts.as_mut() {
-            p.seed = self.seed;
+            p.seed = o.cosegment.seed;
         }
         if let Some(band) = self.snap_band {
             o.set_snap_band(band)?;

@@ -64,9 +64,11 @@ pub struct ShapeLabels {
 /// # std::fs::remove_file(&p).unwrap();
 /// ```
 pub fn read_label_file(path: &Path) -> Result<(LabelKind, Vec<i32>), LabelError> {
-    let data = std::fs::read(path).map_err(|source| LabelError::Io {
-        path: path.display().to_string(),
-        source,
+    let data = std::fs::read(path).map_err(|source| {
+        LabelError::Io(crate::FileError {
+            path: path.display().to_string(),
+            source,
+        })
     })?;
     parse_label_file(&data, path)
 }
@@ -125,9 +127,11 @@ pub fn read_shape_labels(
     mesh: &TriMesh,
     mesh_name: &str,
 ) -> Result<ShapeLabels, LabelError> {
-    let data = std::fs::read(path).map_err(|source| LabelError::Io {
-        path: path.display().to_string(),
-        source,
+    let data = std::fs::read(path).map_err(|source| {
+        LabelError::Io(crate::FileError {
+            path: path.display().to_string(),
+            source,
+        })
     })?;
     parse_shape_labels(&data, path, mesh, mesh_name)
 }
@@ -257,9 +261,11 @@ pub fn match_label_files(
     for input in inputs {
         if input.is_dir() {
             let mut files: Vec<PathBuf> = std::fs::read_dir(input)
-                .map_err(|source| LabelError::Io {
-                    path: input.display().to_string(),
-                    source,
+                .map_err(|source| {
+                    LabelError::Io(crate::FileError {
+                        path: input.display().to_string(),
+                        source,
+                    })
                 })?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| is_label_file(p))
@@ -290,10 +296,10 @@ pub fn match_label_files(
             })?;
             add(&mut found, i, input.clone())?;
         } else {
-            return Err(LabelError::Io {
+            return Err(LabelError::Io(crate::FileError {
                 path: input.display().to_string(),
                 source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file or folder"),
-            });
+            }));
         }
     }
     Ok((found.into_iter().collect(), warnings))
@@ -314,9 +320,11 @@ pub fn read_part_names(path: &Path) -> Result<PartNames, LabelError> {
         path: path.display().to_string(),
         message,
     };
-    let text = std::fs::read_to_string(path).map_err(|source| LabelError::Io {
-        path: path.display().to_string(),
-        source,
+    let text = std::fs::read_to_string(path).map_err(|source| {
+        LabelError::Io(crate::FileError {
+            path: path.display().to_string(),
+            source,
+        })
     })?;
     let raw: BTreeMap<String, String> = serde_json::from_str(&text)
         .map_err(|e| bad(format!("expected a JSON object {{label: name}}: {e}")))?;
@@ -337,9 +345,11 @@ fn write_lines(path: &Path, labels: &[i32]) -> Result<(), LabelError> {
         }
         Ok(())
     })
-    .map_err(|source| LabelError::Io {
-        path: path.display().to_string(),
-        source,
+    .map_err(|source| {
+        LabelError::Io(crate::FileError {
+            path: path.display().to_string(),
+            source,
+        })
     })
 }
 

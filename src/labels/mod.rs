@@ -42,14 +42,8 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum LabelError {
     /// A file could not be read or written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The I/O error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
     /// A line is not an integer (`line` is 1-based).
     #[error("{path}:{line}: {text:?} is not an integer label")]
     BadLabel {

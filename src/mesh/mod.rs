@@ -31,14 +31,8 @@ pub use validate::{MeshReport, MeshWarning};
 #[derive(Debug, Error)]
 pub enum MeshError {
     /// The file could not be opened, read or written.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file concerned.
-        path: String,
-        /// The underlying I/O error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
     /// The file's extension does not name a supported format.
     #[error("{path}: unsupported mesh format (expected .obj, .off or .ply)")]
     UnsupportedFormat {
@@ -131,7 +125,10 @@ impl MeshError {
     pub fn with_path(self, path: &str) -> Self {
         let p = path.to_string();
         match self {
-            MeshError::Io { source, .. } => MeshError::Io { path: p, source },
+            MeshError::Io(e) => MeshError::Io(crate::FileError {
+                path: p,
+                source: e.source,
+            }),
             MeshError::UnsupportedFormat { .. } => MeshError::UnsupportedFormat { path: p },
             MeshError::Parse { message, .. } => MeshError::Parse { path: p, message },
             MeshError::Empty {

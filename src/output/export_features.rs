@@ -55,17 +55,21 @@ pub fn export_features(
             bands.vertices, bands.features
         )));
     }
-    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
-        path: dir.display().to_string(),
-        source,
+    std::fs::create_dir_all(dir).map_err(|source| {
+        OutputError::Io(crate::FileError {
+            path: dir.display().to_string(),
+            source,
+        })
     })?;
     let names = descriptors.names();
     let mut written = Vec::new();
     let mut put = |name: &str, bytes: Vec<u8>| -> Result<(), OutputError> {
         let path = dir.join(name);
-        write_atomic(&path, |w| w.write_all(&bytes)).map_err(|source| OutputError::Io {
-            path: path.display().to_string(),
-            source,
+        write_atomic(&path, |w| w.write_all(&bytes)).map_err(|source| {
+            OutputError::Io(crate::FileError {
+                path: path.display().to_string(),
+                source,
+            })
         })?;
         written.push(path);
         Ok(())
@@ -147,9 +151,11 @@ fn features_meta(
 fn npy<T: npyz::AutoSerialize + Copy>(data: &[T], shape: &[usize]) -> Result<Vec<u8>, OutputError> {
     use npyz::WriterBuilder;
     let mut buf = Vec::new();
-    let io = |source| OutputError::Io {
-        path: "<npy buffer>".into(),
-        source,
+    let io = |source| {
+        OutputError::Io(crate::FileError {
+            path: "<npy buffer>".into(),
+            source,
+        })
     };
     let shape: Vec<u64> = shape.iter().map(|&s| s as u64).collect();
     let mut w = npyz::WriteOptions::new()

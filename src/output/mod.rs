@@ -45,14 +45,8 @@ use thiserror::Error;
 #[derive(Debug, Error)]
 pub enum OutputError {
     /// Writing a file failed.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
     /// Writing a mesh failed.
     #[error(transparent)]
     Mesh(#[from] crate::mesh::MeshError),

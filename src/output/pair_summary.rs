@@ -138,42 +138,18 @@ impl PairSummary {
         correspondence_ratio: Option<f64>,
         seconds: f64,
     ) -> Self {
-        Self::new(
-            shapes,
-            &pair.regions,
-            &options.regions,
-            correspondence_ratio,
-            seconds,
-        )
-        .with_refine(options.refine.clone())
-        .with_map_guided(pair.map_guided.clone())
-        .with_map_preset(pair.map_preset)
-        .with_fallbacks(pair.fallbacks.clone())
-    }
-
-    /// Records that the regions were refined with `refine` (see
-    /// [`refine_regions`](crate::stable::refine_regions)).
-    pub fn with_refine(mut self, refine: Option<RefineOptions>) -> Self {
-        self.refine = refine;
-        self
-    }
-
-    /// Records that B's regions were re-assigned by
-    /// [`map_guided_refinement`](crate::stable::map_guided_refinement) with `options`.
-    pub fn with_map_guided(mut self, options: Option<MapGuidedOptions>) -> Self {
-        self.map_guided = options;
-        self
-    }
-
-    /// Records the map step's preset choice.
-    pub fn with_map_preset(mut self, choice: Option<PresetChoice>) -> Self {
-        self.map_preset = choice;
-        self
-    }
-
-    /// Records the optional stages that fell back (see [`PairSummary::fallbacks`]).
-    pub fn with_fallbacks(mut self, fallbacks: Vec<StageFallback>) -> Self {
-        self.fallbacks = fallbacks;
-        self
+        Self {
+            refine: options.refine.clone(),
+            map_guided: pair.map_guided.clone(),
+            map_preset: pair.map_preset,
+            fallbacks: pair.fallbacks.clone(),
+            ..Self::new(
+                shapes,
+                &pair.regions,
+                &options.regions,
+                correspondence_ratio,
+                seconds,
+            )
+        }
     }
 }

@@ -134,14 +134,18 @@ pub fn write_viewer(
         .replace("__GL_FUNCTIONS__\n", GL_FUNCTIONS)
         .replace("__GL_PROGRAM__\n", GL_PROGRAM)
         .replace("__COSEG_DATA__", &json);
-    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
-        path: dir.display().to_string(),
-        source,
+    std::fs::create_dir_all(dir).map_err(|source| {
+        OutputError::Io(crate::FileError {
+            path: dir.display().to_string(),
+            source,
+        })
     })?;
     let path = dir.join("index.html");
-    write_atomic(&path, |w| w.write_all(html.as_bytes())).map_err(|source| OutputError::Io {
-        path: path.display().to_string(),
-        source,
+    write_atomic(&path, |w| w.write_all(html.as_bytes())).map_err(|source| {
+        OutputError::Io(crate::FileError {
+            path: path.display().to_string(),
+            source,
+        })
     })?;
     Ok(path)
 }

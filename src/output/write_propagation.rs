@@ -165,9 +165,11 @@ pub fn write_propagation(
     c: &PropagatedCollection,
     summary: &PropagationSummary,
 ) -> Result<Vec<PathBuf>, OutputError> {
-    std::fs::create_dir_all(dir).map_err(|source| OutputError::Io {
-        path: dir.display().to_string(),
-        source,
+    std::fs::create_dir_all(dir).map_err(|source| {
+        OutputError::Io(crate::FileError {
+            path: dir.display().to_string(),
+            source,
+        })
     })?;
     let mut out = Vec::new();
     for i in 0..c.graph.node_count() {

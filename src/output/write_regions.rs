@@ -65,9 +65,11 @@ fn check_name(name: &str) -> Result<(), OutputError> {
 }
 
 fn io_err(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
-    move |source| OutputError::Io {
-        path: path.display().to_string(),
-        source,
+    move |source| {
+        OutputError::Io(crate::FileError {
+            path: path.display().to_string(),
+            source,
+        })
     }
 }
 

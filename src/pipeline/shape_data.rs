@@ -29,14 +29,8 @@ pub enum PipelineError {
     #[error(transparent)]
     Bands(#[from] BandError),
     /// The cache directory could not be created.
-    #[error("{path}: {source}")]
-    Io {
-        /// The directory or file concerned.
-        path: String,
-        /// The underlying I/O error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
 }
 
 /// Every option of the per-shape stages; all of it goes into the cache key.

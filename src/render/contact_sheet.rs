@@ -280,9 +280,11 @@ pub fn write_pictures(
         }
     }
     let sheet = render_sheet(shapes, part_names, opts)?;
-    std::fs::create_dir_all(dir).map_err(|source| RenderError::Io {
-        path: dir.display().to_string(),
-        source,
+    std::fs::create_dir_all(dir).map_err(|source| {
+        RenderError::Io(crate::FileError {
+            path: dir.display().to_string(),
+            source,
+        })
     })?;
     let mut paths = vec![dir.join("preview.png")];
     write_png(&paths[0], &sheet)?;

@@ -55,14 +55,8 @@ pub enum RenderError {
     #[error("invalid render options: {0}")]
     Options(String),
     /// Writing a file failed.
-    #[error("{path}: {source}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The underlying error.
-        #[source]
-        source: std::io::Error,
-    },
+    #[error(transparent)]
+    Io(#[from] crate::FileError),
 }
 
 /// An 8-bit RGB image, rows top to bottom, `width * height * 3` bytes.

@@ -33,8 +33,10 @@ pub fn encode_png(img: &RgbImage) -> Vec<u8> {
 /// Writes `img` as a PNG file at `path`, atomically (temporary file + rename).
 pub fn write_png(path: &Path, img: &RgbImage) -> Result<(), RenderError> {
     let bytes = encode_png(img);
-    write_atomic(path, |w| w.write_all(&bytes)).map_err(|source| RenderError::Io {
-        path: path.display().to_string(),
-        source,
+    write_atomic(path, |w| w.write_all(&bytes)).map_err(|source| {
+        RenderError::Io(crate::FileError {
+            path: path.display().to_string(),
+            source,
+        })
     })
 }

@@ -33,6 +33,7 @@ pub use correspondence_ratio::{
     CorrespondenceStats, VertexMap, correspondence_ratio, correspondence_stats,
 };
 pub use initial_indicator::{Init, initial_indicator};
+pub(crate) use initial_indicator::{most_extreme_vertex, random_half};
 pub use map_guided_refinement::{map_guided_refinement, point_map_refinement};
 pub(crate) use refine_partition::best_two;
 pub use refine_partition::{
@@ -93,3 +94,26 @@ pub enum StableError {
     #[error("ground-truth map: {0}")]
     BadMap(String),
 }
+
+/// `FromStr` for an option enum by the names `coseg pair`'s flags and Python's keywords give
+/// its values: the names and the error naming the option kept in one place.
+macro_rules! from_names {
+    ($ty:ty, $option:literal, $($name:literal => $value:expr),+) => {
+        impl std::str::FromStr for $ty {
+            type Err = StableError;
+
+            fn from_str(s: &str) -> Result<Self, StableError> {
+                match s {
+                    $($name => Ok($value),)+
+                    _ => Err(StableError::BadOption(format!(
+                        concat!($option, " {:?}: expected one of", $(" `", $name, "`"),+),
+                        s
+                    ))),
+                }
+            }
+        }
+    };
+}
+
+from_names!(Algorithm, "algorithm", "fixed" => Algorithm::Fixed, "auto" => Algorithm::Auto);
+from_names!(Init, "init", "random" => Init::Random, "extreme" => Init::Extreme);

@@ -29,6 +29,29 @@ impl Default for RefineOptions {
 }
 
 impl RefineOptions {
+    /// `max_rounds` rounds at `smoothing_time`, or `None` (no refinement) for 0 rounds: a
+    /// stage's refinement as `--refine-rounds` and `--smoothing-time` (and Python's
+    /// `refine_rounds`, `smoothing_time`) set it.
+    ///
+    /// ```
+    /// use coseg::stable::RefineOptions;
+    /// assert_eq!(RefineOptions::rounds(0, 3e-3), None);
+    /// assert_eq!(RefineOptions::rounds(4, 0.0).unwrap().max_rounds, 4);
+    /// ```
+    pub fn rounds(max_rounds: usize, smoothing_time: f64) -> Option<Self> {
+        (max_rounds > 0).then_some(Self {
+            max_rounds,
+            smoothing_time,
+        })
+    }
+
+    /// The rounds and smoothing time of `refine` (0 rounds for `None`), the inverse of
+    /// [`Self::rounds`]: what a command's flags show as their defaults.
+    pub fn rounds_of(refine: Option<&Self>) -> (usize, f64) {
+        let r = refine.cloned().unwrap_or_default();
+        (refine.map_or(0, |r| r.max_rounds), r.smoothing_time)
+    }
+
     pub(crate) fn validate(&self) -> Result<(), StableError> {
         if !(self.smoothing_time.is_finite() && self.smoothing_time >= 0.0) {
             return Err(StableError::BadOption(format!(

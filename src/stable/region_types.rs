@@ -5,7 +5,13 @@
 use super::{Init, StableError, Threshold};
 use serde::{Deserialize, Serialize};
 
-/// Which multi-pair algorithm to run.
+/// Which multi-pair algorithm to run; parsed from `fixed` or `auto` (`coseg pair --algorithm`).
+///
+/// ```
+/// use coseg::stable::Algorithm;
+/// assert_eq!("auto".parse::<Algorithm>().unwrap(), Algorithm::Auto);
+/// assert!("fast".parse::<Algorithm>().unwrap_err().to_string().contains("`fixed` `auto`"));
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 pub enum Algorithm {
     /// Algorithm 2: fixed thresholds `P`, `Q` for every pair.

@@ -112,9 +112,11 @@ pub fn read_mesh_with_report(path: impl AsRef<Path>) -> Result<(TriMesh, MeshRep
     let name = path.display().to_string();
     let format = MeshFormat::from_path(path)
         .ok_or_else(|| MeshError::UnsupportedFormat { path: name.clone() })?;
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        path: name.clone(),
-        source,
+    let bytes = std::fs::read(path).map_err(|source| {
+        MeshError::Io(crate::FileError {
+            path: name.clone(),
+            source,
+        })
     })?;
     let (mesh, mut parse_warnings) = parse(&bytes, format).map_err(|e| e.with_path(&name))?;
     let mut report = mesh.report();
@@ -190,7 +192,7 @@ pub fn write_mesh(
         MeshFormat::Off => off::write(w, mesh),
         MeshFormat::Ply => ply::write(w, mesh, properties),
     })
-    .map_err(|source| MeshError::Io { path: name, source })
+    .map_err(|source| MeshError::Io(crate::FileError { path: name, source }))
 }
 
 /// Builds a [`MeshError::Parse`] for an in-memory source, with an optional 1-based line number.
