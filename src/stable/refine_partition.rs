@@ -48,8 +48,10 @@ impl RefineOptions {
     /// The rounds and smoothing time of `refine` (0 rounds for `None`), the inverse of
     /// [`Self::rounds`]: what a command's flags show as their defaults.
     pub fn rounds_of(refine: Option<&Self>) -> (usize, f64) {
-        let r = refine.cloned().unwrap_or_default();
-        (refine.map_or(0, |r| r.max_rounds), r.smoothing_time)
+        match refine {
+            Some(r) => (r.max_rounds, r.smoothing_time),
+            None => (0, Self::default().smoothing_time),
+        }
     }
 
     pub(crate) fn validate(&self) -> Result<(), StableError> {
