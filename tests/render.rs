@@ -5,8 +5,8 @@ mod common;
 use common::features::{blob, permutation, permute_mesh, similarity};
 use coseg::mesh::TriMesh;
 use coseg::render::{
-    RenderOptions, RenderShape, RgbImage, canonical_frame, draw_mesh, encode_png, render_shape,
-    render_sheet, write_pictures,
+    RenderOptions, RenderShape, RgbImage, canonical_frame, collection_views, draw_mesh, encode_png,
+    render_shape, render_sheet, write_pictures,
 };
 
 fn decode(bytes: &[u8]) -> RgbImage {
@@ -137,18 +137,21 @@ fn sheet_has_the_documented_size_and_same_part_same_colour() {
             mesh: &a,
             labels: &labels,
             confidence: Some(0.5),
+            view: None,
         },
         RenderShape {
             name: "b",
             mesh: &b,
             labels: &labels,
             confidence: None,
+            view: None,
         },
         RenderShape {
             name: "c",
             mesh: &a,
             labels: &labels,
             confidence: None,
+            view: None,
         },
     ];
     let mut opts = RenderOptions::default();
@@ -171,6 +174,7 @@ fn sheet_has_the_documented_size_and_same_part_same_colour() {
             mesh: &a,
             labels: &[0],
             confidence: None,
+            view: None,
         }],
         None,
         &opts,
@@ -201,6 +205,7 @@ fn pictures_decode_with_expected_size_many_colours_and_identical_bytes_twice() {
         mesh: &a,
         labels: &labels,
         confidence: None,
+        view: None,
     }];
     let dir = tempfile::tempdir().unwrap();
     let paths = write_pictures(dir.path(), &shapes, None, &RenderOptions::default()).unwrap();
@@ -214,4 +219,77 @@ fn pictures_decode_with_expected_size_many_colours_and_identical_bytes_twice() {
         assert_eq!(&std::fs::read(p).unwrap(), bytes, "{}", p.display());
     }
     assert_eq!(decode(&encode_png(&img)), img);
+}
+
+/// The shipped quadrupeds, read from the repository.
+fn quadrupeds() -> Vec<TriMesh> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("collections/quadrupeds");
+    (0..3)
+        .map(|i| coseg::mesh::read_mesh(dir.join(format!("quadrupeds_0{i}.obj"))).unwrap())
+        .collect()
+}
+
+/// Different shapes, each moved at random, are drawn from one side: each view's axes, carried
+/// back through the shape's motion, are the same directions of the unmoved files for every
+/// shape (each shape's own principal frame is not: the quadrupeds' longest axes differ).
+#[test]
+fn collection_views_see_every_moved_shape_from_the_same_side() {
+    let shapes = quadrupeds();
+    let mut rng = <rand_chacha::ChaCha8Rng as rand::SeedableRng>::seed_from_u64(3);
+    let motions: Vec<coseg::align::Similarity> = shapes
+        .iter()
+        .map(|_| common::motion::random_similarity(&mut rng))
+        .collect();
+    let moved: Vec<TriMesh> = shapes
+        .iter()
+        .zip(&motions)
+        .map(|(m, t)| m.map_positions(|p| t.apply(p)).unwrap())
+        .collect();
+    let alignment =
+        coseg::align::align_collection(&moved, &coseg::align::AlignOptions::default()).unwrap();
+    assert_eq!(alignment.case, coseg::align::FrameCase::Synchronised);
+    let views = collection_views(&moved, &alignment);
+    // An axis of the view in the unmoved file's coordinates.
+    let unmoved = |i: usize, k: usize| motions[i].inverse().rotate(views[i].axes[k]);
+    let degrees = |a: [f64; 3], b: [f64; 3]| {
+        let c = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+        c.clamp(-1.0, 1.0).acos().to_degrees()
+    };
+    for i in 1..shapes.len() {
+        for k in 0..3 {
+            let angle = degrees(unmoved(0, k), unmoved(i, k));
+            // The alignment places these quadrupeds within 5° of each other (tests/cli_align.rs);
+            // a flipped or swapped axis is 90° or 180° off.
+            assert!(angle < 10.0, "shape {i}, axis {k}: {angle}°");
+        }
+    }
+}
+
+/// Files whose frames already agree are drawn upright as written (`+y` on screen up, seen
+/// from 20° above) and all from one camera.
+#[test]
+fn collection_views_keep_the_files_up_axis_when_already_aligned() {
+    let meshes = quadrupeds();
+    let alignment =
+        coseg::align::align_collection(&meshes, &coseg::align::AlignOptions::default()).unwrap();
+    assert_eq!(alignment.case, coseg::align::FrameCase::AlreadyAligned);
+    let views = collection_views(&meshes, &alignment);
+    for v in &views {
+        assert!(
+            (v.axes[1][1] - 20f64.to_radians().cos()).abs() < 1e-9,
+            "{v:?}"
+        );
+        assert!(
+            v.axes[0][1].abs() < 1e-9,
+            "screen right is horizontal: {v:?}"
+        );
+        assert_eq!(v.axes, views[0].axes);
+    }
+    // Unlike each shape's own principal frame, which follows the longest axis.
+    assert!(
+        views
+            .iter()
+            .zip(&meshes)
+            .any(|(v, m)| canonical_frame(m).axes != v.axes)
+    );
 }

@@ -4,7 +4,7 @@ use anyhow::{Context, Result, bail};
 use clap::Args;
 use coseg::evaluate::read_labels;
 use coseg::mesh::{TriMesh, read_mesh_with_report};
-use coseg::render::{RenderOptions, RenderShape, render_sheet, write_png};
+use coseg::render::{RenderOptions, RenderShape, collection_views_or_own, render_sheet, write_png};
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -58,7 +58,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             args.meshes.len()
         );
     }
-    let mut meshes: Vec<(String, TriMesh, Vec<i32>)> = Vec::new();
+    let (mut names, mut meshes, mut all_labels) = (Vec::new(), Vec::<TriMesh>::new(), Vec::new());
     for (i, path) in args.meshes.iter().enumerate() {
         let (mesh, report) = read_mesh_with_report(path)?;
         for w in &report.warnings {
@@ -81,15 +81,26 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
             }
             None => vec![-1; mesh.vertex_count()],
         };
-        meshes.push((display_name(path), mesh, labels));
+        names.push(display_name(path));
+        meshes.push(mesh);
+        all_labels.push(labels);
     }
-    let shapes: Vec<RenderShape> = meshes
+    // One view for every shape drawn: the collection's own frame.
+    let (views, warning) = collection_views_or_own(&meshes);
+    if let Some(w) = warning {
+        super::warn(format_args!("{w}"));
+    }
+    let shapes: Vec<RenderShape> = names
         .iter()
-        .map(|(name, mesh, labels)| RenderShape {
+        .zip(&meshes)
+        .zip(&all_labels)
+        .zip(views)
+        .map(|(((name, mesh), labels), view)| RenderShape {
             name,
             mesh,
             labels,
             confidence: None,
+            view: Some(view),
         })
         .collect();
     let mut options = RenderOptions::default();

@@ -10,7 +10,7 @@ use crate::propagate::{
     PropagateCollectionOptions, PropagateError, PropagatedCollection, SourceFile,
     propagate_collection, propagate_loaded,
 };
-use crate::render::{RenderOptions, RenderShape};
+use crate::render::{RenderOptions, RenderShape, collection_views_or_own};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -113,7 +113,7 @@ pub fn run_propagate(
             source: Box::new(e),
         }
     };
-    let (result, cache_outcomes) = match input {
+    let (mut result, cache_outcomes) = match input {
         PropagateInput::Folder { folder, labels } => {
             let context = format!("propagating labels over {}", folder.display());
             let result =
@@ -151,6 +151,8 @@ pub fn run_propagate(
         drop(timer);
         if job.pictures {
             let _t = crate::stage_timer::stage("pictures");
+            let (views, warning) = collection_views_or_own(&result.meshes);
+            result.warnings.extend(warning);
             let p = &result.propagation;
             let pictures: Vec<RenderShape> = (0..result.graph.node_count())
                 .map(|i| RenderShape {
@@ -158,6 +160,7 @@ pub fn run_propagate(
                     mesh: &result.meshes[i],
                     labels: &p.labels[i],
                     confidence: Some(p.shape_confidence[i]),
+                    view: Some(views[i]),
                 })
                 .collect();
             let names = legend_names(&p.parts, &result.part_names);

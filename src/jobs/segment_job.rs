@@ -8,7 +8,7 @@ use crate::mesh::TriMesh;
 use crate::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
 use crate::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentedCollection};
 use crate::pipeline::ShapePipelineOptions;
-use crate::render::{RenderOptions, RenderShape};
+use crate::render::{RenderOptions, RenderShape, collection_views_or_own};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
@@ -279,7 +279,7 @@ pub fn run_segment_with_progress(
         written = write_regions(dir, &shapes, &summary)?;
         if job.pictures {
             progress(SegmentProgress::Stage("pictures"));
-            written.extend(draw(dir, &shapes, &summary)?);
+            written.extend(draw(dir, &shapes, &meshes, &summary, &mut warnings)?);
         }
     }
     Ok(SegmentOutcome {
@@ -317,17 +317,32 @@ fn check_count(n: usize) -> Result<(), JobError> {
 }
 
 /// preview.png, <name>.png and index.html, legends naming each region by its confidence.
+/// Every shape seen from the collection's one view ([`collection_views_or_own`]; `meshes` in
+/// the order of `shapes`).
 fn draw(
     out: &Path,
     shapes: &[ShapeRegions],
+    meshes: &[TriMesh],
     summary: &CollectionSummary,
+    warnings: &mut Vec<String>,
 ) -> Result<Vec<PathBuf>, JobError> {
-    let pictures: Vec<RenderShape> = shapes.iter().map(ShapeRegions::picture).collect();
+    let (views, warning) = collection_views_or_own(meshes);
+    warnings.extend(warning);
+    let pictures: Vec<RenderShape> = shapes
+        .iter()
+        .zip(views)
+        .map(|(s, v)| RenderShape {
+            view: Some(v),
+            ..s.picture()
+        })
+        .collect();
     let names: Vec<String> = summary
         .regions
         .iter()
         .map(|r| {
-            if r.leftover {
+            // In the parts modes every part is a part: the leftover tuple of the regions
+            // they are grouped from is merged into one of them, not shown as "leftovers".
+            if r.leftover && summary.parts.is_none() {
                 "leftovers".to_string()
             } else {
                 format!("({:.0}%)", 100.0 * r.confidence)

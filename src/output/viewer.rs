@@ -1,7 +1,8 @@
 //! [`write_viewer`]: `OUT/index.html`, one self-contained interactive 3D view of every shape.
 //!
 //! The page needs no network: the meshes are embedded as base64 of little-endian arrays
-//! (positions `f32`, already in each shape's canonical view and scaled to unit radius;
+//! (positions `f32`, already in each shape's view ([`RenderShape::frame`]: the collection's shared view where
+//! the job gave one, else the shape's canonical view) and scaled to unit radius;
 //! triangle indices `u32`; colours `u8` RGB from [`region_colors`]) in a JSON block, and
 //! about 150 lines of our own WebGL 1 code draw them. Drag rotates, the wheel zooms, the list
 //! picks a shape; the legend names the parts and each shape shows its confidence. The page
@@ -9,7 +10,7 @@
 
 use super::{OutputError, region_colors};
 use crate::mesh::write_atomic;
-use crate::render::{RenderShape, canonical_frame, labels_present};
+use crate::render::{RenderShape, labels_present};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
@@ -57,7 +58,7 @@ fn page_data(shapes: &[RenderShape<'_>], part_names: Option<&[String]>) -> serde
     let shapes: Vec<serde_json::Value> = shapes
         .iter()
         .map(|s| {
-            let frame = canonical_frame(s.mesh);
+            let frame = s.frame();
             let view: Vec<[f64; 3]> = s
                 .mesh
                 .positions()
@@ -105,7 +106,7 @@ fn page_data(shapes: &[RenderShape<'_>], part_names: Option<&[String]>) -> serde
 /// use coseg::render::RenderShape;
 /// let mesh = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
 /// let dir = std::env::temp_dir().join(format!("coseg-doc-viewer-{}", std::process::id()));
-/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: Some(0.5) };
+/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: Some(0.5), view: None };
 /// let path = write_viewer(&dir, &[shape], None).unwrap();
 /// let html = std::fs::read_to_string(&path).unwrap();
 /// assert!(html.contains("\"name\":\"tri\"") && !html.contains("http"));

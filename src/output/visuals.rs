@@ -16,7 +16,7 @@ use std::path::{Path, PathBuf};
 /// use coseg::render::{RenderOptions, RenderShape};
 /// let mesh = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
 /// let dir = std::env::temp_dir().join(format!("coseg-doc-visuals-{}", std::process::id()));
-/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: None };
+/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: None, view: None };
 /// let names = vec!["head".to_string(), "tail".to_string()];
 /// let paths = write_visuals(&dir, &[shape], Some(&names), &RenderOptions::default()).unwrap();
 /// assert_eq!(paths.len(), 3);

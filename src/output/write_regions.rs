@@ -46,13 +46,14 @@ impl<'a> ShapeRegions<'a> {
             .collect()
     }
 
-    /// The shape as the pictures draw it (coloured by region, no confidence).
+    /// The shape as the pictures draw it (coloured by region, no confidence, its own view).
     pub fn picture(&self) -> crate::render::RenderShape<'a> {
         crate::render::RenderShape {
             name: self.name,
             mesh: self.mesh,
             labels: self.regions,
             confidence: None,
+            view: None,
         }
     }
 }

@@ -1,6 +1,6 @@
 //! [`canonical_frame`]: the view every picture and the viewer page start from.
 
-use crate::mesh::TriMesh;
+use crate::mesh::{TriMesh, cross, dot, sub};
 use nalgebra::{Matrix3, SymmetricEigen};
 
 /// An orthonormal, right-handed view frame: screen right, screen up and toward the viewer.
@@ -19,22 +19,6 @@ impl ViewFrame {
         let d = sub(p, self.center);
         self.axes.map(|a| dot(d, a))
     }
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
 }
 
 /// The canonical view of a mesh, from its principal axes; the same rule for every shape.
@@ -60,19 +44,8 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// ```
 pub fn canonical_frame(mesh: &TriMesh) -> ViewFrame {
     let pos = mesh.positions();
-    let mut w = mesh.vertex_areas();
+    let (w, c) = weighted_centroid(mesh);
     let total: f64 = w.iter().sum();
-    if total <= 0.0 || !total.is_finite() {
-        w = vec![1.0; pos.len()];
-    }
-    let total: f64 = w.iter().sum();
-    let mut c = [0.0; 3];
-    for (p, &wi) in pos.iter().zip(&w) {
-        for k in 0..3 {
-            c[k] += wi * p[k];
-        }
-    }
-    c = c.map(|x| x / total);
     let mut cov = Matrix3::<f64>::zeros();
     for (p, &wi) in pos.iter().zip(&w) {
         let d = sub(*p, c);
@@ -118,4 +91,23 @@ pub fn canonical_frame(mesh: &TriMesh) -> ViewFrame {
     }
     axes[2] = cross(axes[0], axes[1]);
     ViewFrame { center: c, axes }
+}
+
+/// The vertex weights of the views (barycentric vertex areas; uniform if the mesh has no
+/// area) and the weighted centroid of the vertices.
+pub(super) fn weighted_centroid(mesh: &TriMesh) -> (Vec<f64>, [f64; 3]) {
+    let pos = mesh.positions();
+    let mut w = mesh.vertex_areas();
+    let total: f64 = w.iter().sum();
+    if total <= 0.0 || !total.is_finite() {
+        w = vec![1.0; pos.len()];
+    }
+    let total: f64 = w.iter().sum();
+    let mut c = [0.0; 3];
+    for (p, &wi) in pos.iter().zip(&w) {
+        for k in 0..3 {
+            c[k] += wi * p[k];
+        }
+    }
+    (w, c.map(|x| x / total))
 }

@@ -1,7 +1,9 @@
 //! [`render_sheet`], [`render_shape`] and [`write_pictures`]: labelled pictures of shapes.
 
 use super::region_colors;
-use super::{RenderError, RgbImage, canonical_frame, draw_mesh, draw_text, text_width, write_png};
+use super::{
+    RenderError, RgbImage, ViewFrame, canonical_frame, draw_mesh, draw_text, text_width, write_png,
+};
 use crate::mesh::TriMesh;
 use std::path::{Path, PathBuf};
 
@@ -16,6 +18,16 @@ pub struct RenderShape<'a> {
     pub labels: &'a [i32],
     /// Optional confidence in [0, 1], shown after the name as a percentage.
     pub confidence: Option<f64>,
+    /// The view to draw it from (`None`: the shape's own [`canonical_frame`]); a collection's
+    /// pictures share one view, [`super::collection_views`].
+    pub view: Option<ViewFrame>,
+}
+
+impl RenderShape<'_> {
+    /// The view the shape is drawn from: [`RenderShape::view`], else its canonical view.
+    pub fn frame(&self) -> ViewFrame {
+        self.view.unwrap_or_else(|| canonical_frame(self.mesh))
+    }
 }
 
 /// Every label of `shapes` (the unlabelled `-1` too), ascending, once each: the legend's
@@ -115,7 +127,7 @@ fn fit(text: &str, width: u32, scale: u32) -> String {
 
 fn draw_cell(img: &mut RgbImage, x: u32, y: u32, shape: &RenderShape<'_>, opts: &RenderOptions) {
     let s = opts.cell_size;
-    let frame = canonical_frame(shape.mesh);
+    let frame = shape.frame();
     let colors = region_colors(shape.labels);
     draw_mesh(img, [x, y, s, s], shape.mesh, &colors, &frame);
     let text = fit(&caption(shape), s - 4, opts.font_scale);
@@ -176,7 +188,7 @@ fn legend(
 /// use coseg::mesh::TriMesh;
 /// use coseg::render::{RenderOptions, RenderShape, render_sheet};
 /// let mesh = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
-/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: None };
+/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: None, view: None };
 /// let sheet = render_sheet(&[shape, shape], None, &RenderOptions::default()).unwrap();
 /// assert_eq!(sheet.width, 2 * RenderOptions::default().cell_size);
 /// ```
@@ -233,7 +245,7 @@ pub fn render_sheet(
 /// use coseg::mesh::TriMesh;
 /// use coseg::render::{RenderOptions, RenderShape, render_shape};
 /// let mesh = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
-/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: Some(0.9) };
+/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: Some(0.9), view: None };
 /// let img = render_shape(&shape, &RenderOptions::default()).unwrap();
 /// assert_eq!(img.width, 240);
 /// ```
@@ -258,7 +270,7 @@ pub fn render_shape(
 /// use coseg::render::{RenderOptions, RenderShape, write_pictures};
 /// let mesh = TriMesh::new(vec![[0., 0., 0.], [1., 0., 0.], [0., 1., 0.]], vec![[0, 1, 2]]).unwrap();
 /// let dir = std::env::temp_dir().join(format!("coseg-doc-pictures-{}", std::process::id()));
-/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: None };
+/// let shape = RenderShape { name: "tri", mesh: &mesh, labels: &[0, 1, 1], confidence: None, view: None };
 /// let paths = write_pictures(&dir, &[shape], None, &RenderOptions::default()).unwrap();
 /// assert_eq!(paths, vec![dir.join("preview.png"), dir.join("tri.png")]);
 /// # std::fs::remove_dir_all(&dir).unwrap();

@@ -1,8 +1,10 @@
 //! Pictures of results: a small CPU rasteriser (z-buffer, orthographic, no GPU, no display).
 //!
-//! Every shape is drawn from its [canonical view](canonical_frame): its principal axes, with a
-//! sign rule that depends only on the shape, so the same rule applies to every shape of a
-//! collection. Vertices are coloured by label with [`region_colors`] (the
+//! A collection's shapes are drawn from one view ([`collection_views`]): a three-quarter view
+//! from slightly above in the collection frame of [`crate::align::align_collection`], carried
+//! to each shape by its rotation, so every shape is seen from the same side. A shape drawn
+//! alone (or when the alignment fails) is drawn from its [canonical view](canonical_frame): its
+//! principal axes, with a sign rule that depends only on the shape. Vertices are coloured by label with [`region_colors`] (the
 //! colours of the coloured PLY files), so a part has one colour on every shape. Lighting is a
 //! two-sided head light (ambient + Lambert) on interpolated vertex normals; each pixel takes
 //! the colour of the nearest corner of its triangle, which keeps part boundaries crisp.
@@ -16,6 +18,7 @@
 //! Everything is computed serially in `f64`: the same inputs give the same bytes.
 
 mod canonical_view;
+mod collection_view;
 mod contact_sheet;
 mod font;
 mod png_io;
@@ -23,6 +26,7 @@ mod rasterise;
 mod region_colors;
 
 pub use canonical_view::{ViewFrame, canonical_frame};
+pub use collection_view::{collection_views, collection_views_or_own};
 pub(crate) use contact_sheet::labels_present;
 pub use contact_sheet::{RenderOptions, RenderShape, render_shape, render_sheet, write_pictures};
 pub use font::{draw_text, text_width};
