@@ -32,13 +32,7 @@ pub fn nearest_point_labels(
     target: &TriMesh,
     transform: &Similarity,
 ) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
-    if source_face_labels.len() != source.face_count() {
-        return Err(AlignError::LabelCount {
-            expected: source.face_count(),
-            found: source_face_labels.len(),
-            kind: "face",
-        });
-    }
+    check_count(source_face_labels, source.face_count(), "face")?;
     let index = SurfaceIndex::new(source);
     Ok(nearest(&index, target, transform, |c| {
         source_face_labels[c.face]
@@ -77,13 +71,7 @@ pub(crate) fn nearest_point_vertex_labels_in(
     target: &TriMesh,
     transform: &Similarity,
 ) -> Result<(Vec<i32>, Vec<f64>), AlignError> {
-    if source_vertex_labels.len() != source.vertex_count() {
-        return Err(AlignError::LabelCount {
-            expected: source.vertex_count(),
-            found: source_vertex_labels.len(),
-            kind: "vertex",
-        });
-    }
+    check_count(source_vertex_labels, source.vertex_count(), "vertex")?;
     let faces = source.faces();
     Ok(nearest(index, target, transform, |c| {
         let mut k = 0;
@@ -94,6 +82,19 @@ pub(crate) fn nearest_point_vertex_labels_in(
         }
         source_vertex_labels[faces[c.face][k] as usize]
     }))
+}
+
+/// [`AlignError::LabelCount`] unless `labels` holds one label per source face or vertex
+/// (`kind`), of which the source has `expected`.
+fn check_count(labels: &[i32], expected: usize, kind: &'static str) -> Result<(), AlignError> {
+    if labels.len() != expected {
+        return Err(AlignError::LabelCount {
+            expected,
+            found: labels.len(),
+            kind,
+        });
+    }
+    Ok(())
 }
 
 /// Per target vertex (moved by `transform`), the label `label` reads off the closest point
