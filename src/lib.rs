@@ -44,6 +44,7 @@ pub mod jobs;
 pub mod labels;
 pub mod maps;
 pub mod mesh;
+mod option_range;
 pub mod output;
 pub mod parts;
 pub mod pipeline;

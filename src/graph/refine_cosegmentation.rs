@@ -4,6 +4,7 @@
 use super::shape_graph::ShapeGraph;
 use super::{Cosegmentation, GraphError};
 use crate::affinity::kernel::{Block, LANES, row_sum};
+use crate::option_range::non_negative;
 use crate::spectral::HeatSmoother;
 use crate::stable::{RefineOptions, StableError, assign_regions, best_two};
 use rayon::prelude::*;
@@ -93,12 +94,8 @@ pub fn refine_cosegmentation_sized(
     sizes: RefineSizes,
 ) -> Result<Cosegmentation, GraphError> {
     check_inputs(graph, coseg, smoothers, options)?;
-    if let RefineSizes::Keep { tolerance } = sizes
-        && !(tolerance.is_finite() && tolerance >= 0.0)
-    {
-        return Err(GraphError::BadOption(format!(
-            "size tolerance = {tolerance} must be finite and non-negative"
-        )));
+    if let RefineSizes::Keep { tolerance } = sizes {
+        non_negative("size tolerance", tolerance).map_err(GraphError::BadOption)?;
     }
     let n = graph.node_count();
     let regions = coseg.tuples.len();
@@ -367,12 +364,7 @@ fn check_inputs(
             "one heat smoother per shape, with the shape's vertex count, is needed".into(),
         ));
     }
-    if !(options.smoothing_time.is_finite() && options.smoothing_time >= 0.0) {
-        return Err(GraphError::BadOption(format!(
-            "smoothing_time = {} must be finite and non-negative",
-            options.smoothing_time
-        )));
-    }
+    non_negative("smoothing_time", options.smoothing_time).map_err(GraphError::BadOption)?;
     Ok(())
 }
 

@@ -2,6 +2,7 @@
 //! candidate lists (Bertsekas' auction algorithm), used by
 //! [`zoomout`](super::zoomout) to read its last point map.
 
+use crate::option_range::non_negative;
 use crate::spectral::SpectralError;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -408,12 +409,7 @@ fn validate(
     {
         return bad(format!("the costs of query {q} are not sorted ascending"));
     }
-    if !(options.penalty.is_finite() && options.penalty >= 0.0) {
-        return bad(format!(
-            "penalty = {} must be finite and non-negative",
-            options.penalty
-        ));
-    }
+    non_negative("penalty", options.penalty).or_else(bad)?;
     if !(options.epsilon.is_finite() && options.epsilon > 0.0) {
         return bad(format!(
             "epsilon = {} must be finite and positive",

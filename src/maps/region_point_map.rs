@@ -5,6 +5,7 @@
 use super::MapError;
 use super::zoomout::{eigenvectors, validate, zoomout_from};
 use super::{ShapeGeometry, ZoomOutOptions};
+use crate::option_range::non_negative;
 use crate::spectral::Spectrum;
 use faer::MatRef;
 use nalgebra::{DMatrix, DVector};
@@ -102,12 +103,7 @@ pub fn region_point_map(
             )));
         }
     }
-    if !(options.commutativity.is_finite() && options.commutativity >= 0.0) {
-        return Err(MapError::InvalidOption(format!(
-            "commutativity = {} must be finite and non-negative",
-            options.commutativity
-        )));
-    }
+    non_negative("commutativity", options.commutativity).map_err(MapError::InvalidOption)?;
     let k = options.zoomout.initial_size;
     let c = initial_map(
         a,

@@ -3,6 +3,7 @@
 
 use super::nearest_rows::{OwnedBase, QueryRows, gather_rows, in_single, nearest_candidates_owned};
 use super::{AuctionOptions, CandidateLists, auction_assignment};
+use crate::option_range::non_negative;
 use crate::spectral::{SpectralError, Spectrum};
 use faer::linalg::matmul::matmul;
 use faer::{Accum, Mat, MatMut, MatRef, Par};
@@ -213,12 +214,8 @@ pub(crate) fn validate(
             )));
         }
     }
-    if !(options.descriptor_weight.is_finite() && options.descriptor_weight >= 0.0) {
-        return Err(SpectralError::InvalidOption(format!(
-            "descriptor_weight = {} must be finite and non-negative",
-            options.descriptor_weight
-        )));
-    }
+    non_negative("descriptor_weight", options.descriptor_weight)
+        .map_err(SpectralError::InvalidOption)?;
     if matches!(
         options.final_match,
         FinalMatch::Bijective { candidates: 0, .. }

@@ -57,6 +57,7 @@ use crate::graph::{
     Cosegmentation, Engine, Extraction, GraphError, RegionTuple, ShapeGraph, area, area_fractions,
     check_extraction, seed_region, tuple_hash,
 };
+use crate::option_range::non_negative;
 use crate::stable::{Threshold, ThresholdScratch, threshold};
 use serde::{Deserialize, Serialize};
 
@@ -607,12 +608,7 @@ fn check(graph: &ShapeGraph, o: &AdaptiveOptions) -> Result<(), GraphError> {
             o.delta_t, o.t_max
         )));
     }
-    if !(o.size_tolerance.is_finite() && o.size_tolerance >= 0.0) {
-        return Err(GraphError::BadOption(format!(
-            "size_tolerance = {} must be finite and non-negative",
-            o.size_tolerance
-        )));
-    }
+    non_negative("size_tolerance", o.size_tolerance).map_err(GraphError::BadOption)?;
     Ok(())
 }
 

@@ -8,6 +8,7 @@ use super::{
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
+use crate::option_range::non_negative;
 use crate::parts::{
     AdaptiveCosegmentation, FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions,
     SegmentedCollection, StopReason, segment_collection_sharing, snap_part_boundaries,
@@ -68,12 +69,7 @@ impl RouteOptions {
     }
 
     pub(crate) fn validate(&self) -> Result<(), PropagateError> {
-        if !(self.snap_band.is_finite() && self.snap_band >= 0.0) {
-            return Err(PropagateError::BadOption(format!(
-                "snap_band = {} must be finite and non-negative",
-                self.snap_band
-            )));
-        }
+        non_negative("snap_band", self.snap_band).map_err(PropagateError::BadOption)?;
         Ok(())
     }
 }

@@ -1,6 +1,7 @@
 //! [`PropagateOptions`]: how labels travel from the labelled shapes to the others.
 
 use super::{PartScore, PropagateError};
+use crate::option_range::non_negative;
 use serde::{Deserialize, Serialize};
 
 /// Options of [`propagate_labels`](super::propagate_labels).
@@ -81,29 +82,13 @@ impl Default for PropagateOptions {
 impl PropagateOptions {
     pub(crate) fn validate(&self) -> Result<(), PropagateError> {
         let bad = |m: String| Err(PropagateError::BadOption(m));
-        if !(self.smoothing_time.is_finite() && self.smoothing_time >= 0.0) {
-            return bad(format!(
-                "smoothing_time = {} must be finite and non-negative",
-                self.smoothing_time
-            ));
-        }
-        if !(self.network_weight.is_finite() && self.network_weight >= 0.0) {
-            return bad(format!(
-                "network_weight = {} must be finite and non-negative",
-                self.network_weight
-            ));
-        }
-        if !(self.similarity_power.is_finite() && self.similarity_power >= 0.0) {
-            return bad(format!(
-                "similarity_power = {} must be finite and non-negative",
-                self.similarity_power
-            ));
-        }
-        if !(self.refit_weight.is_finite() && self.refit_weight >= 0.0) {
-            return bad(format!(
-                "refit_weight = {} must be finite and non-negative",
-                self.refit_weight
-            ));
+        for (name, value) in [
+            ("smoothing_time", self.smoothing_time),
+            ("network_weight", self.network_weight),
+            ("similarity_power", self.similarity_power),
+            ("refit_weight", self.refit_weight),
+        ] {
+            non_negative(name, value).map_err(PropagateError::BadOption)?;
         }
         if !(0.0..=1.0).contains(&self.size_prior) {
             return bad(format!(

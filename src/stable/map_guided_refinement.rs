@@ -5,6 +5,7 @@ use super::refine_regions::rebuild_regions;
 use super::{StableError, StableRegions, region_scores};
 use crate::affinity::{BandAffinity, Direction};
 use crate::maps::{MapGuidedOptions, MapShape, ShapeGeometry, region_point_map};
+use crate::option_range::non_negative;
 use crate::spectral::HeatSmoother;
 
 /// Sharpens B's side of corresponding partitions with a point map. A's regions are kept; every
@@ -61,18 +62,8 @@ pub fn map_guided_refinement(
     smoother_b: Option<&HeatSmoother>,
     options: &MapGuidedOptions,
 ) -> Result<StableRegions, StableError> {
-    if !(options.map_weight.is_finite() && options.map_weight >= 0.0) {
-        return Err(StableError::BadOption(format!(
-            "map_weight = {} must be finite and non-negative",
-            options.map_weight
-        )));
-    }
-    if !(options.smoothing_time.is_finite() && options.smoothing_time >= 0.0) {
-        return Err(StableError::BadOption(format!(
-            "smoothing_time = {} must be finite and non-negative",
-            options.smoothing_time
-        )));
-    }
+    non_negative("map_weight", options.map_weight).map_err(StableError::BadOption)?;
+    non_negative("smoothing_time", options.smoothing_time).map_err(StableError::BadOption)?;
     if a.spectrum.vertex_count() != regions.vertices_a
         || b.spectrum.vertex_count() != regions.vertices_b
     {
@@ -154,11 +145,7 @@ pub fn point_map_refinement(
     smoother_b: Option<&HeatSmoother>,
     map_weight: f64,
 ) -> Result<StableRegions, StableError> {
-    if !(map_weight.is_finite() && map_weight >= 0.0) {
-        return Err(StableError::BadOption(format!(
-            "map_weight = {map_weight} must be finite and non-negative"
-        )));
-    }
+    non_negative("map_weight", map_weight).map_err(StableError::BadOption)?;
     let d = regions.vertices_b;
     if map.len() != d || areas_b.len() != d || areas_a.len() != regions.vertices_a {
         return Err(StableError::BadOption(format!(

@@ -4,6 +4,7 @@
 
 use super::StableError;
 use crate::affinity::{AffinityWorkspace, BandAffinity, Direction};
+use crate::option_range::non_negative;
 use crate::spectral::HeatSmoother;
 use serde::{Deserialize, Serialize};
 
@@ -55,12 +56,7 @@ impl RefineOptions {
     }
 
     pub(crate) fn validate(&self) -> Result<(), StableError> {
-        if !(self.smoothing_time.is_finite() && self.smoothing_time >= 0.0) {
-            return Err(StableError::BadOption(format!(
-                "smoothing_time = {} must be finite and non-negative",
-                self.smoothing_time
-            )));
-        }
+        non_negative("smoothing_time", self.smoothing_time).map_err(StableError::BadOption)?;
         Ok(())
     }
 }

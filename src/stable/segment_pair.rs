@@ -13,6 +13,7 @@ use crate::bands::BandTable;
 use crate::maps::ShapeGeometry;
 use crate::maps::{MapGuidedOptions, MapStep, PresetChoice};
 use crate::mesh::TriMesh;
+use crate::option_range::non_negative;
 use crate::spectral::{HeatSmoother, Spectrum};
 use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
@@ -325,15 +326,7 @@ fn check_stage_options(
     refine: Option<&RefineOptions>,
     map_guided: Option<&MapGuidedOptions>,
 ) -> Result<(), StableError> {
-    let non_negative = |name: &str, x: f64| {
-        if x.is_finite() && x >= 0.0 {
-            Ok(())
-        } else {
-            Err(StableError::BadOption(format!(
-                "{name} = {x} must be finite and non-negative"
-            )))
-        }
-    };
+    let non_negative = |name: &str, x: f64| non_negative(name, x).map_err(StableError::BadOption);
     if let Some(r) = refine {
         non_negative("refine smoothing_time", r.smoothing_time)?;
     }
