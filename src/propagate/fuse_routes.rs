@@ -232,14 +232,7 @@ pub fn fuse_routes_with(
                 let l = labels.max(2) as f64;
                 out.weights[i][r] =
                     log_odds(((acc[x] - 1.0 / l) / (1.0 - 1.0 / l)).max(0.0), labels);
-                out.agreement[i][r] = routes[r].labels[i]
-                    .iter()
-                    .zip(&fl)
-                    .zip(a)
-                    .filter(|((p, q), _)| **p >= 0 && p == q)
-                    .map(|(_, w)| w)
-                    .sum::<f64>()
-                    / total;
+                out.agreement[i][r] = agreement(&routes[r].labels[i], &fl, a, total);
             }
             out.labels[i] = fl;
             out.confidence[i] = fc;
@@ -284,19 +277,25 @@ pub fn fuse_routes_with(
         }
         for (x, &r) in voting.iter().enumerate() {
             out.weights[i][r] = trust[x];
-            out.agreement[i][r] = routes[r].labels[i]
-                .iter()
-                .zip(&labels)
-                .zip(a)
-                .filter(|((p, q), _)| **p >= 0 && p == q)
-                .map(|(_, w)| w)
-                .sum::<f64>()
-                / total;
+            out.agreement[i][r] = agreement(&routes[r].labels[i], &labels, a, total);
         }
         out.labels[i] = labels;
         out.confidence[i] = conf;
     }
     out
+}
+
+/// The area share (of `total`) where `x` labels a vertex and `y` gives it the same label: a
+/// route's [`FusedRoutes::agreement`] with the fused labels, and the raw agreement of
+/// [`cohen_kappa`].
+fn agreement(x: &[i32], y: &[i32], areas: &[f64], total: f64) -> f64 {
+    x.iter()
+        .zip(y)
+        .zip(areas)
+        .filter(|((p, q), _)| **p >= 0 && p == q)
+        .map(|(_, w)| w)
+        .sum::<f64>()
+        / total
 }
 
 /// The chance-corrected agreement (Cohen's κ, area-weighted) of every pair of the `voting`
@@ -333,14 +332,7 @@ pub(crate) fn cohen_kappa(x: &[i32], y: &[i32], areas: &[f64]) -> f64 {
         s
     };
     let (sx, sy) = (shares(x), shares(y));
-    let agree: f64 = x
-        .iter()
-        .zip(y)
-        .zip(areas)
-        .filter(|((p, q), _)| **p >= 0 && p == q)
-        .map(|(_, w)| w)
-        .sum::<f64>()
-        / total;
+    let agree = agreement(x, y, areas, total);
     let chance: f64 = sx
         .iter()
         .map(|(l, s)| s * sy.get(l).copied().unwrap_or(0.0))
