@@ -8,6 +8,9 @@
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::{Rng, SeedableRng};
 
+// The mesh's vector helpers (only `+ − ×` and `sqrt`, like the rest of this module).
+pub(crate) use crate::mesh::{dot, norm as len, sub};
+
 /// A point or vector in 3D.
 pub(crate) type V3 = [f64; 3];
 
@@ -16,20 +19,8 @@ pub(crate) fn add(a: V3, b: V3) -> V3 {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 #[inline]
-pub(crate) fn sub(a: V3, b: V3) -> V3 {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-#[inline]
 pub(crate) fn scale(a: V3, s: f64) -> V3 {
     [a[0] * s, a[1] * s, a[2] * s]
-}
-#[inline]
-pub(crate) fn dot(a: V3, b: V3) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-#[inline]
-pub(crate) fn len(a: V3) -> f64 {
-    dot(a, a).sqrt()
 }
 
 /// sin(x) from a Taylor series after reduction to [−π, π]; accurate to ~1e-15, deterministic.
