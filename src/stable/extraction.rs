@@ -2,11 +2,44 @@
 //! [`super::stable_pairs_auto`]): the remaining vertices, their areas, one Algorithm 1 run on
 //! them, removal of a found pair, and the leftovers pair.
 
-use super::region_types::RegionPair;
+use super::region_types::{RegionPair, StableRegions, StableRegionsOptions};
 use super::stable_pair::stable_pair_inner;
 use super::{Remaining, StableError, StablePair, StablePairOptions, StableWorkspace};
 use crate::affinity::BandAffinity;
 use crate::vertex_sets::remove_sorted;
+
+/// The frame of Algorithms 2 and 3: after checking `options` and the areas, up to
+/// `options.pairs − 1` pairs, each from `next(extraction, i)` on what the earlier ones left
+/// (`None`: stop early; so does a shape that runs out of vertices), then the leftovers as the
+/// last pair.
+pub(crate) fn extract_pairs<'s>(
+    w: &BandAffinity<'_>,
+    areas_a: &'s [f64],
+    areas_b: &'s [f64],
+    options: &StableRegionsOptions,
+    mut next: impl FnMut(&mut Extraction<'s>, usize) -> Result<Option<RegionPair>, StableError>,
+) -> Result<StableRegions, StableError> {
+    options.validate()?;
+    let mut ex = Extraction::new(w, areas_a, areas_b)?;
+    let mut pairs = Vec::with_capacity(options.pairs);
+    for i in 0..options.pairs - 1 {
+        if ex.rem_a.is_empty() || ex.rem_b.is_empty() {
+            break;
+        }
+        let Some(pair) = next(&mut ex, i)? else {
+            break;
+        };
+        pairs.push(pair);
+    }
+    if !ex.rem_a.is_empty() || !ex.rem_b.is_empty() {
+        pairs.push(ex.leftovers(w)?);
+    }
+    Ok(StableRegions {
+        vertices_a: w.cols(),
+        vertices_b: w.rows(),
+        pairs,
+    })
+}
 
 /// Shared state of Algorithms 2 and 3: remaining vertices and areas.
 pub(crate) struct Extraction<'s> {

@@ -1,6 +1,6 @@
 //! [`stable_pairs_auto`]: Algorithm 3, stable pairs with automatic thresholds.
 
-use super::extraction::Extraction;
+use super::extraction::{Extraction, extract_pairs};
 use super::region_types::{AutoThreshold, StableRegions, StableRegionsOptions, TSearch};
 use super::{StableError, StablePair, StablePairOptions, Threshold, initial_indicator};
 use crate::affinity::BandAffinity;
@@ -34,15 +34,9 @@ pub fn stable_pairs_auto(
     areas_b: &[f64],
     options: &StableRegionsOptions,
 ) -> Result<StableRegions, StableError> {
-    options.validate()?;
-    let mut ex = Extraction::new(w, areas_a, areas_b)?;
-    let mut pairs = Vec::with_capacity(options.pairs);
     let steps = (options.t_max / options.delta_t).floor().max(0.0) as usize;
     let mut prev_step = 0usize;
-    for i in 0..options.pairs - 1 {
-        if ex.rem_a.is_empty() || ex.rem_b.is_empty() {
-            break;
-        }
+    extract_pairs(w, areas_a, areas_b, options, |ex, i| {
         let (rem_area_a, rem_area_b) = (ex.remaining_area_a(), ex.remaining_area_b());
         let f_in = initial_indicator(w, &ex.rem_a, options.init, options.seed, i);
         let mut search_iterations = 0;
@@ -65,7 +59,7 @@ pub fn stable_pairs_auto(
             TSearch::Linear => {
                 let mut last = None;
                 for s in 0..=steps {
-                    let Some(found) = probe(s, &start, &mut ex)? else {
+                    let Some(found) = probe(s, &start, ex)? else {
                         break;
                     };
                     if options.warm_start {
@@ -77,14 +71,16 @@ pub fn stable_pairs_auto(
             }
             TSearch::Bisect => bisect_search(
                 &mut probe,
-                &mut ex,
+                ex,
                 &mut start,
                 prev_step.min(steps),
                 steps,
                 options.warm_start,
             )?,
         };
-        let Some((t, pt)) = last else { break };
+        let Some((t, pt)) = last else {
+            return Ok(None);
+        };
         prev_step = (t / options.delta_t).round() as usize;
         let alpha =
             (ex.area_a(&pt.region_a) / rem_area_a).max(ex.area_b(&pt.region_b) / rem_area_b);
@@ -95,7 +91,7 @@ pub fn stable_pairs_auto(
         };
         let pair = ex.run(w, &pt.region_a, &opts, (rem_area_a, rem_area_b))?;
         if pair.region_a.is_empty() || pair.region_b.is_empty() {
-            break;
+            return Ok(None);
         }
         let mut rp = ex.take(pair);
         rp.auto = Some(AutoThreshold {
@@ -103,15 +99,7 @@ pub fn stable_pairs_auto(
             alpha,
             search_iterations,
         });
-        pairs.push(rp);
-    }
-    if !ex.rem_a.is_empty() || !ex.rem_b.is_empty() {
-        pairs.push(ex.leftovers(w)?);
-    }
-    Ok(StableRegions {
-        vertices_a: w.cols(),
-        vertices_b: w.rows(),
-        pairs,
+        Ok(Some(rp))
     })
 }
 

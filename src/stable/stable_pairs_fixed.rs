@@ -1,6 +1,6 @@
 //! [`stable_pairs_fixed`]: Algorithm 2, several stable pairs with fixed thresholds.
 
-use super::extraction::Extraction;
+use super::extraction::extract_pairs;
 use super::region_types::{AreaReference, StableRegions, StableRegionsOptions};
 use super::{StableError, StablePairOptions, initial_indicator};
 use crate::affinity::BandAffinity;
@@ -31,18 +31,12 @@ pub fn stable_pairs_fixed(
     areas_b: &[f64],
     options: &StableRegionsOptions,
 ) -> Result<StableRegions, StableError> {
-    options.validate()?;
-    let mut ex = Extraction::new(w, areas_a, areas_b)?;
     let opts = StablePairOptions {
         p: options.p,
         q: options.q,
         max_iterations: options.max_iterations,
     };
-    let mut pairs = Vec::with_capacity(options.pairs);
-    for i in 0..options.pairs - 1 {
-        if ex.rem_a.is_empty() || ex.rem_b.is_empty() {
-            break;
-        }
+    extract_pairs(w, areas_a, areas_b, options, |ex, i| {
         let reference = match options.area_reference {
             AreaReference::Total => (ex.total_a, ex.total_b),
             AreaReference::Remaining => (ex.remaining_area_a(), ex.remaining_area_b()),
@@ -50,16 +44,8 @@ pub fn stable_pairs_fixed(
         let f0 = initial_indicator(w, &ex.rem_a, options.init, options.seed, i);
         let pair = ex.run(w, &f0, &opts, reference)?;
         if pair.region_a.is_empty() || pair.region_b.is_empty() {
-            break;
+            return Ok(None);
         }
-        pairs.push(ex.take(pair));
-    }
-    if !ex.rem_a.is_empty() || !ex.rem_b.is_empty() {
-        pairs.push(ex.leftovers(w)?);
-    }
-    Ok(StableRegions {
-        vertices_a: w.cols(),
-        vertices_b: w.rows(),
-        pairs,
+        Ok(Some(ex.take(pair)))
     })
 }
