@@ -226,12 +226,7 @@ pub(crate) fn gather_rows<T: Element>(m: MatRef<'_, T>, rows: &[usize]) -> Mat<T
 /// [`gather_rows`] into `out` (`rows.len() × m.ncols()`, column-major).
 fn gather_rows_into<T: Element>(mut out: MatMut<'_, T>, m: MatRef<'_, T>, rows: &[usize]) {
     for j in 0..m.ncols() {
-        let dst = out
-            .as_mut()
-            .col_mut(j)
-            .try_as_col_major_mut()
-            .expect("column-major")
-            .as_slice_mut();
+        let dst = col_slice_mut(out.as_mut(), j);
         match m.col(j).try_as_col_major() {
             Some(src) => {
                 let src = src.as_slice();
@@ -249,15 +244,19 @@ fn gather_rows_into<T: Element>(mut out: MatMut<'_, T>, m: MatRef<'_, T>, rows: 
     }
 }
 
+/// Column `j` of `m` as a slice: the matrices here are faer's own, column-major.
+pub(crate) fn col_slice_mut<T>(m: MatMut<'_, T>, j: usize) -> &mut [T] {
+    m.col_mut(j)
+        .try_as_col_major_mut()
+        .expect("column-major")
+        .as_slice_mut()
+}
+
 /// `m` in single precision, column by column.
 pub(crate) fn single(m: MatRef<'_, f64>) -> Mat<f32> {
     let mut out = Mat::<f32>::zeros(m.nrows(), m.ncols());
     for j in 0..m.ncols() {
-        let dst = out
-            .col_mut(j)
-            .try_as_col_major_mut()
-            .expect("owned")
-            .as_slice_mut();
+        let dst = col_slice_mut(out.as_mut(), j);
         for (d, &x) in dst.iter_mut().zip(m.col(j).iter()) {
             *d = x as f32;
         }
@@ -673,11 +672,7 @@ fn search_group<Q: QueryRows + ?Sized>(
     let mut candidates = Mat::<f32>::zeros(total, base.ncols());
     for j in 0..base.ncols() {
         let src = base.col(j).try_as_col_major().expect("owned").as_slice();
-        let dst = candidates
-            .col_mut(j)
-            .try_as_col_major_mut()
-            .expect("owned")
-            .as_slice_mut();
+        let dst = col_slice_mut(candidates.as_mut(), j);
         let mut at = 0;
         for &(s, e) in &runs {
             dst[at..at + e - s].copy_from_slice(&src[s..e]);

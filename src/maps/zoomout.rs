@@ -1,7 +1,9 @@
 //! [`zoomout`]: refine a vertex-to-vertex map between two shapes spectrally (Melzi et al.,
 //! *ZoomOut: spectral upsampling for efficient shape correspondence*, 2019).
 
-use super::nearest_rows::{OwnedBase, QueryRows, gather_rows, in_single, nearest_candidates_owned};
+use super::nearest_rows::{
+    OwnedBase, QueryRows, col_slice_mut, gather_rows, in_single, nearest_candidates_owned,
+};
 use super::{AuctionOptions, CandidateLists, auction_assignment};
 use crate::option_range::non_negative;
 use crate::spectral::{SpectralError, Spectrum};
@@ -342,11 +344,7 @@ impl WithDescriptors<'_> {
         let (d, k) = (self.x.nrows(), self.x.ncols());
         let mut out = Mat::<T>::zeros(rows.len(), k + self.scales.len());
         for j in 0..out.ncols() {
-            let dst = out
-                .col_mut(j)
-                .try_as_col_major_mut()
-                .expect("owned")
-                .as_slice_mut();
+            let dst = col_slice_mut(out.as_mut(), j);
             if j < k {
                 let src = self.x.col(j);
                 for (o, &r) in dst.iter_mut().zip(rows) {
@@ -434,11 +432,7 @@ fn append_descriptors<T: Copy>(
         return;
     };
     for (j, col) in descriptors.chunks_exact(out.nrows()).enumerate() {
-        let dst = out
-            .col_mut(k + j)
-            .try_as_col_major_mut()
-            .expect("owned")
-            .as_slice_mut();
+        let dst = col_slice_mut(out.as_mut(), k + j);
         for (o, &v) in dst.iter_mut().zip(col) {
             *o = narrow(scales[j] * v);
         }
