@@ -770,6 +770,30 @@ fn part_shares(labels: &[i32], areas: &[f64], np: usize) -> Vec<f64> {
     s
 }
 
+/// Floor of a part's area share in [`fit_sizes`]: keeps the target and the steps finite for a
+/// part the prior or the plain assignment gives no area.
+const SHARE_FLOOR: f64 = 1e-4;
+
+/// The area shares [`fit_sizes`] aims at: `prior^α · plain^(1−α)` per part (each share floored
+/// at [`SHARE_FLOOR`]), normalised to sum 1.
+fn size_target(prior: &[f64], plain: &[f64], alpha: f64) -> Vec<f64> {
+    let mut target: Vec<f64> = (0..plain.len())
+        .map(|r| {
+            prior[r].max(SHARE_FLOOR).powf(alpha) * plain[r].max(SHARE_FLOOR).powf(1.0 - alpha)
+        })
+        .collect();
+    let t: f64 = target.iter().sum();
+    target.iter_mut().for_each(|x| *x /= t);
+    target
+}
+
+/// How far `shares` are from `target`: the largest difference over the parts.
+fn share_error(shares: &[f64], target: &[f64]) -> f64 {
+    (0..target.len())
+        .map(|r| (shares[r] - target[r]).abs())
+        .fold(0.0, f64::max)
+}
+
 /// Best part per vertex of `scores` (column-major `d × np`) scaled per part by factors fitted
 /// so that the parts' area shares approach `prior^α · plain^(1−α)` (`plain`: the shares of the
 /// unscaled assignment); returns the labels and relative margins of the scaling whose shares
@@ -804,17 +828,8 @@ fn fit_sizes(
     if alpha <= 0.0 || np < 2 {
         return (labels, margins);
     }
-    let floor = 1e-4;
-    let mut target: Vec<f64> = (0..np)
-        .map(|r| prior[r].max(floor).powf(alpha) * plain[r].max(floor).powf(1.0 - alpha))
-        .collect();
-    let t: f64 = target.iter().sum();
-    target.iter_mut().for_each(|x| *x /= t);
-    let err_of = |shares: &[f64]| {
-        (0..np)
-            .map(|r| (shares[r] - target[r]).abs())
-            .fold(0.0, f64::max)
-    };
+    let target = size_target(prior, &plain, alpha);
+    let err_of = |shares: &[f64]| share_error(shares, &target);
     // Multiplicative steps on the part scales, accepted only while they do not move the shares
     // away from the target (a plateau is accepted: the scales drift across a flat stretch);
     // a step that overshoots is retried at half the exponent. Near-tied scores make the
@@ -828,7 +843,7 @@ fn fit_sizes(
             break;
         }
         let mut next: Vec<f64> = (0..np)
-            .map(|r| scale[r] * (target[r] / shares[r].max(floor)).powf(step))
+            .map(|r| scale[r] * (target[r] / shares[r].max(SHARE_FLOOR)).powf(step))
             .collect();
         let m = next.iter().copied().fold(0.0, f64::max);
         next.iter_mut().for_each(|s| *s /= m);
@@ -883,16 +898,8 @@ mod tests {
             let (fit, margins) = fit_sizes(&scores, np, &areas, &prior, alpha);
             let p = shares_of(&plain, &areas, np);
             let f = shares_of(&fit, &areas, np);
-            let mut target: Vec<f64> = (0..np)
-                .map(|r| prior[r].max(1e-4).powf(alpha) * p[r].max(1e-4).powf(1.0 - alpha))
-                .collect();
-            let t: f64 = target.iter().sum();
-            target.iter_mut().for_each(|x| *x /= t);
-            let err = |s: &[f64]| {
-                (0..np)
-                    .map(|r| (s[r] - target[r]).abs())
-                    .fold(0.0, f64::max)
-            };
+            let target = size_target(&prior, &p, alpha);
+            let err = |s: &[f64]| share_error(s, &target);
             assert!(
                 err(&f) <= err(&p),
                 "case {case}: fitted shares {f:?} farther from {target:?} than plain {p:?}"
