@@ -16,7 +16,7 @@ use std::time::Instant;
 // The seeded motion the tests give shapes (one definition for both).
 #[path = "../tests/common/motion.rs"]
 mod motion;
-use motion::random_similarity;
+use motion::{net_motions, random_similarity};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -82,13 +82,7 @@ fn collection(args: &[String]) -> Result<(), Box<dyn std::error::Error>> {
     let t = Instant::now();
     let a = align_collection(&meshes, &options)?;
     let wall = t.elapsed().as_secs_f64();
-    // recovered ∘ true: the same rotation for every shape when the frame is right.
-    let net: Vec<Similarity> = a
-        .shapes
-        .iter()
-        .zip(&truth)
-        .map(|(s, t)| s.transform.compose(t))
-        .collect();
+    let net = net_motions(&a, &truth);
     // With an axis of revolution `a` (collection frame), rotations about it are forgiven:
     // each shape is then judged by where its net rotation takes `a` from (`netᵀ a`, the
     // file-frame axis), which a turn about `a` does not change.

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::motion::{random_similarity, unit};
+use common::motion::{net_motions, random_similarity, unit};
 use coseg::align::{
     AlignError, AlignOptions, FrameCase, RegisterOptions, Similarity, align_collection,
     closest_surface_points, nearest_point_labels, nearest_point_vertex_labels, register_pair,
@@ -199,12 +199,7 @@ fn align_collection_recovers_moved_quadrupeds() {
         .collect();
     let a = align_collection(&moved, &AlignOptions::default()).unwrap();
     assert_eq!(a.case, FrameCase::Synchronised);
-    let net: Vec<Similarity> = a
-        .shapes
-        .iter()
-        .zip(&truth)
-        .map(|(s, t)| s.transform.compose(t))
-        .collect();
+    let net = net_motions(&a, &truth);
     for n in &net {
         assert!(n.rotation_angle_to(&net[0]) < 5.0, "{n:?}");
     }

@@ -4,7 +4,7 @@
 mod common;
 
 use coseg::graph::{Cosegmentation, RegionTuple};
-use coseg::propagate::{RouteLabels, fuse_routes, fuse_routes_with, parts_route};
+use coseg::propagate::{FusedRoutes, RouteLabels, fuse_routes, fuse_routes_with, parts_route};
 use rand::{RngExt, SeedableRng};
 
 /// Route labels on shape 1 of two (shape 0 a source): `labels` with confidence `conf`.
@@ -45,6 +45,25 @@ fn turned(truth: &[i32], tenths: usize) -> Vec<i32> {
         .collect()
 }
 
+/// [`fuse_routes`] on owned routes and areas.
+fn fuse(routes: &[RouteLabels], areas: &[Vec<f64>]) -> FusedRoutes {
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas: Vec<&[f64]> = areas.iter().map(Vec::as_slice).collect();
+    fuse_routes(&refs, &areas)
+}
+
+/// [`fuse_routes_with`] on owned routes and areas.
+fn fuse_with(
+    routes: &[RouteLabels],
+    areas: &[Vec<f64>],
+    held_out: Option<&[f64]>,
+    shared: Option<(usize, usize)>,
+) -> FusedRoutes {
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let areas: Vec<&[f64]> = areas.iter().map(Vec::as_slice).collect();
+    fuse_routes_with(&refs, &areas, held_out, shared)
+}
+
 fn accuracy(a: &[i32], b: &[i32]) -> f64 {
     a.iter().zip(b).filter(|(x, y)| x == y).count() as f64 / a.len() as f64
 }
@@ -63,10 +82,8 @@ fn the_route_the_others_agree_with_wins_where_it_is_outvoted() {
         route(truth.clone(), 0.5),
         route(c, 0.5),
     ];
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas = [vec![1.0; 10], vec![1.0; d]];
-    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
-    let fused = fuse_routes(&refs, &area_refs);
+    let fused = fuse(&routes, &areas);
     assert_eq!(
         fused.labels[0],
         Vec::<i32>::new(),
@@ -92,10 +109,8 @@ fn a_collapsed_route_loses_its_say() {
     let (truth, a) = truth_and_noisy(d, 0.05, 3);
     let (_, b) = truth_and_noisy(d, 0.05, 4);
     let routes = [route(a, 1.0), route(vec![2; d], 1.0), route(b, 1.0)];
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas = [vec![1.0; 4], vec![1.0; d]];
-    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
-    let fused = fuse_routes(&refs, &area_refs);
+    let fused = fuse(&routes, &areas);
     // Where the two good routes disagree (about 10 % of the vertices) nothing tells which
     // is right: about half of those are lost, as by any vote.
     let acc = accuracy(&fused.labels[1], &truth);
@@ -112,11 +127,9 @@ fn fusion_is_deterministic_and_in_range() {
     let (_, b) = truth_and_noisy(d, 0.3, 6);
     let (_, c) = truth_and_noisy(d, 0.1, 7);
     let routes = [route(a, 0.3), route(b, 0.9), route(c, 0.6)];
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas: [Vec<f64>; 2] = [vec![1.0; 3], (0..d).map(|v| 1.0 + (v % 7) as f64).collect()];
-    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
-    let first = fuse_routes(&refs, &area_refs);
-    let second = fuse_routes(&refs, &area_refs);
+    let first = fuse(&routes, &areas);
+    let second = fuse(&routes, &areas);
     assert_eq!(first, second);
     assert!(first.confidence[1].iter().all(|c| (0.0..=1.0).contains(c)));
     assert!(first.agreement[1].iter().all(|a| (0.0..=1.0).contains(a)));
@@ -133,10 +146,8 @@ fn a_route_worse_than_chance_gets_no_weight_and_confidences_stay_in_range() {
     // Every label moved to the next: it agrees with the others below chance.
     let c: Vec<i32> = truth.iter().map(|&l| (l + 1) % 3).collect();
     let routes = [route(a, 0.5), route(b, 0.5), route(c, 0.5)];
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas: [Vec<f64>; 2] = [vec![1.0; 3], vec![1.0; d]];
-    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
-    let fused = fuse_routes(&refs, &area_refs);
+    let fused = fuse(&routes, &areas);
     assert_eq!(fused.weights[1][2], 0.0, "{:?}", fused.weights[1]);
     assert!(
         fused.confidence[1].iter().all(|c| (0.0..=1.0).contains(c)),
@@ -310,10 +321,8 @@ fn intrinsic_routes_failing_together_do_not_outvote_the_rigid_route() {
     // left and right limbs; their joint failure read as agreement under the one-coin model,
     // so the fusion (74.7 %) stayed far under the rigid route (92.1 %).
     let (truth, routes, areas) = mirror_confused(6000);
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
-    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
-    let one_coin = accuracy(&fuse_routes(&refs, &area_refs).labels[1], &truth);
-    let fused = fuse_routes_with(&refs, &area_refs, None, Some((0, 1)));
+    let one_coin = accuracy(&fuse(&routes, &areas).labels[1], &truth);
+    let fused = fuse_with(&routes, &areas, None, Some((0, 1)));
     let shared = accuracy(&fused.labels[1], &truth);
     let rigid = accuracy(&routes[2].labels[1], &truth);
     assert!(
@@ -327,10 +336,7 @@ fn intrinsic_routes_failing_together_do_not_outvote_the_rigid_route() {
     let w = &fused.weights[1];
     assert!(w[2] > w[0] && w[2] > w[1], "weights {w:?}");
     // Deterministic.
-    assert_eq!(
-        fused,
-        fuse_routes_with(&refs, &area_refs, None, Some((0, 1)))
-    );
+    assert_eq!(fused, fuse_with(&routes, &areas, None, Some((0, 1))));
 }
 
 #[test]
@@ -341,10 +347,8 @@ fn a_pair_that_fails_independently_is_fused_as_before() {
     let (truth, b) = truth_and_noisy(d, 0.4, 1);
     let (_, c) = truth_and_noisy(d, 0.4, 2);
     let routes = [route(b, 0.5), route(c, 0.5), route(truth.clone(), 0.5)];
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas = [vec![1.0; 10], vec![1.0; d]];
-    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
-    let fused = fuse_routes_with(&refs, &area_refs, None, Some((0, 1)));
+    let fused = fuse_with(&routes, &areas, None, Some((0, 1)));
     let acc = accuracy(&fused.labels[1], &truth);
     assert!(acc > 0.99, "fused accuracy {acc}");
 }
@@ -356,10 +360,8 @@ fn held_out_accuracies_set_the_level_of_each_routes_trust() {
     // weight (the vote still adds the pair's weights where they agree: the held-out level
     // corrects the trust, not the pair's joint failures).
     let (truth, routes, areas) = mirror_confused(6000);
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
-    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
-    let one_coin = accuracy(&fuse_routes(&refs, &area_refs).labels[1], &truth);
-    let fused = fuse_routes_with(&refs, &area_refs, Some(&[0.65, 0.65, 0.92]), None);
+    let one_coin = accuracy(&fuse(&routes, &areas).labels[1], &truth);
+    let fused = fuse_with(&routes, &areas, Some(&[0.65, 0.65, 0.92]), None);
     let acc = accuracy(&fused.labels[1], &truth);
     assert!(acc >= one_coin, "held-out {acc}, one-coin {one_coin}");
     let w = &fused.weights[1];
@@ -400,17 +402,15 @@ fn a_collapsed_rigid_route_does_not_take_the_shape_from_parts_on_other_features(
     let (_, affinity) = truth_and_noisy(d, 0.45, 6);
     let rigid = turned(&truth, 6);
     let routes = [route(affinity, 1.0), route(parts, 1.0), route(rigid, 1.0)];
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas = [vec![1.0; d], vec![1.0; d]];
-    let a: Vec<&[f64]> = areas.iter().map(|x| x.as_slice()).collect();
-    let one_coin = fuse_routes(&refs, &a);
+    let one_coin = fuse(&routes, &areas);
     assert!(
         accuracy(&one_coin.labels[1], &truth) > 0.9,
         "one-coin vote: {}",
         accuracy(&one_coin.labels[1], &truth)
     );
     // What the shared-failure model does with it: the reason it is kept for intrinsic pairs.
-    let shared = fuse_routes_with(&refs, &a, None, Some((0, 1)));
+    let shared = fuse_with(&routes, &areas, None, Some((0, 1)));
     assert!(accuracy(&shared.labels[1], &truth) < accuracy(&one_coin.labels[1], &truth));
 }
 
@@ -760,9 +760,7 @@ fn a_parts_route_collapsed_with_the_affinity_does_not_outvote_the_rigid_route() 
     // pair's agreement as the affinity being right (fused 42–52 %) while the rigid route was
     // right on 87–97 %.
     let (truth, routes, areas) = parts_collapsed_with_the_affinity(2000);
-    let refs: Vec<&RouteLabels> = routes.iter().collect();
-    let area_refs: Vec<&[f64]> = areas.iter().map(|a| a.as_slice()).collect();
-    let fused = fuse_routes_with(&refs, &area_refs, None, Some((0, 1)));
+    let fused = fuse_with(&routes, &areas, None, Some((0, 1)));
     for (i, t) in truth.iter().enumerate().skip(1) {
         let acc = accuracy(&fused.labels[i], t);
         let rigid = accuracy(&routes[2].labels[i], t);
@@ -787,10 +785,7 @@ fn a_parts_route_collapsed_with_the_affinity_does_not_outvote_the_rigid_route() 
             );
         }
     }
-    assert_eq!(
-        fused,
-        fuse_routes_with(&refs, &area_refs, None, Some((0, 1)))
-    );
+    assert_eq!(fused, fuse_with(&routes, &areas, None, Some((0, 1))));
 }
 
 #[test]

@@ -1,9 +1,9 @@
 //! Seeded random similarities: the motions shapes are given to test that results do not
 //! depend on how files are oriented, sized and placed.
-// examples/bench_align includes this file for `random_similarity` alone.
+// examples/bench_align includes this file for `random_similarity` and `net_motions` alone.
 #![allow(dead_code)]
 
-use coseg::align::Similarity;
+use coseg::align::{CollectionAlignment, Similarity};
 use rand_chacha::ChaCha8Rng;
 use rand_chacha::rand_core::Rng;
 
@@ -16,4 +16,15 @@ pub fn unit(rng: &mut ChaCha8Rng) -> f64 {
 /// each axis ([`Similarity::random`]).
 pub fn random_similarity(rng: &mut ChaCha8Rng) -> Similarity {
     Similarity::random(rng)
+}
+
+/// Per shape, the recovered transform after the true motion (`recovered ∘ true`): the same
+/// rotation for every shape when the collection frame is right.
+pub fn net_motions(alignment: &CollectionAlignment, truth: &[Similarity]) -> Vec<Similarity> {
+    alignment
+        .shapes
+        .iter()
+        .zip(truth)
+        .map(|(s, t)| s.transform.compose(t))
+        .collect()
 }
