@@ -22,7 +22,8 @@ fn goblets() -> (Vec<TriMesh>, Vec<ShapeNode>) {
 }
 
 /// By default the families are chosen and the choice is reported with both candidates'
-/// scores (the extrinsic one for each up axis tried), the winner being the higher; the run is
+/// scores (the extrinsic one for each up axis tried) and the paired test over shapes; both
+/// families are kept unless the spectral family's advantage is significant; the run is
 /// deterministic; with the columns given, nothing is chosen or reported.
 #[test]
 fn the_feature_families_are_chosen_by_the_consistency_each_reaches() {
@@ -37,9 +38,14 @@ fn the_feature_families_are_chosen_by_the_consistency_each_reaches() {
     assert!((1..=2).contains(&f.aligned_scores.len()), "{f:?}");
     let aligned = f.aligned_score.unwrap();
     assert!((0.0..=1.0).contains(&f.intrinsic_score) && (0.0..=1.0).contains(&aligned));
+    let test = f.spectral_advantage.expect("the paired test is reported");
+    assert_eq!(test.shapes, 3);
+    assert!((0.0..=1.0).contains(&test.p_value), "{test:?}");
+    assert_eq!(f.significance, 0.05);
+    assert!(f.reason.contains("paired t-test p = "), "{}", f.reason);
     match f.chosen {
         FeatureSet::IntrinsicExtrinsic => {
-            assert!(aligned > f.intrinsic_score);
+            assert!(test.p_value >= f.significance, "{test:?}");
             assert!(
                 f.reason.starts_with("features spectral,extrinsic"),
                 "{}",
@@ -49,7 +55,7 @@ fn the_feature_families_are_chosen_by_the_consistency_each_reaches() {
             assert!(out.graph.node(0).bands.features > spectral);
         }
         FeatureSet::Intrinsic => {
-            assert!(aligned <= f.intrinsic_score);
+            assert!(test.p_value < f.significance && test.mean > 0.0, "{test:?}");
             assert!(f.reason.starts_with("features spectral:"), "{}", f.reason);
             assert_eq!(out.graph.node(0).bands.features, spectral);
         }
@@ -57,6 +63,25 @@ fn the_feature_families_are_chosen_by_the_consistency_each_reaches() {
     let again = segment_collection(nodes.clone(), &meshes, &o).unwrap();
     assert_eq!(again.segmentation, out.segmentation);
     assert_eq!(again.features, out.features);
+    // The level decides on the same statistic: at level 0 both families are kept; at a level
+    // above the p-value the spectral family alone is used.
+    for (level, chosen) in [
+        (0.0, FeatureSet::IntrinsicExtrinsic),
+        ((test.p_value + 1e-9).min(1.0), FeatureSet::Intrinsic),
+    ] {
+        let mut c = ChooseFeaturesOptions::default();
+        c.significance = level;
+        let mut ol = o.clone();
+        ol.features = FeatureSelection::Chosen(c);
+        let f = segment_collection(nodes.clone(), &meshes, &ol)
+            .unwrap()
+            .features
+            .unwrap();
+        assert_eq!(f.spectral_advantage, Some(test));
+        if level < 1.0 {
+            assert_eq!(f.chosen, chosen, "level {level}: {test:?}");
+        }
+    }
     o.features = FeatureSelection::Given;
     let given = segment_collection(nodes, &meshes, &o).unwrap();
     assert!(given.features.is_none());

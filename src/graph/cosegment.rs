@@ -784,7 +784,7 @@ pub(crate) fn area(areas: &[f64], v: &[u32]) -> f64 {
     v.iter().map(|&p| areas[p as usize]).sum()
 }
 
-fn iou(areas: &[f64], a: &[u32], b: &[u32]) -> f64 {
+pub(crate) fn iou(areas: &[f64], a: &[u32], b: &[u32]) -> f64 {
     let mut inter = Vec::new();
     intersect_sorted(a, b, &mut inter);
     let i = area(areas, &inter);

@@ -10,6 +10,7 @@
 //!   feature pairing and a weight; pairwise affinities exist only as band-table operators.
 //! - [`cosegment`]: consistent region tuples across every shape of the graph (design argued
 //!   in that function's module).
+//! - [`shape_confidences`]: each shape's share of a co-segmentation's confidence.
 //! - [`refine_cosegmentation`]: smoothed best-response refinement of a co-segmentation's
 //!   boundaries over every edge of the graph.
 //! - [`load_collection`]: a folder of meshes to graph nodes through the per-shape cache.
@@ -18,6 +19,7 @@ mod cosegment;
 mod cycle_consistency;
 mod load_collection;
 mod refine_cosegmentation;
+mod shape_confidences;
 mod shape_graph;
 mod stable_cycle;
 
@@ -30,6 +32,7 @@ pub use load_collection::{
     LoadedCollection, SkippedFile, is_coseg_output, load_collection, mesh_files, shape_names,
 };
 pub use refine_cosegmentation::{RefineSizes, refine_cosegmentation, refine_cosegmentation_sized};
+pub use shape_confidences::shape_confidences;
 pub use shape_graph::{GraphKind, GraphOptions, ShapeEdge, ShapeGraph, ShapeNode, shape_summary};
 pub use stable_cycle::{
     CycleShape, CycleStep, StableCycle, StableCycleOptions, stable_cycle, stable_cycle_with,

@@ -25,6 +25,7 @@ mod choose_features;
 mod choose_part_count;
 mod geometric_part_tree;
 mod mirror_pairs;
+mod paired_advantage;
 mod part_cues;
 mod parts_report;
 mod segment_collection;
@@ -46,6 +47,7 @@ pub use geometric_part_tree::{
     geometric_part_tree, geometric_part_tree_linked, geometric_part_tree_with_cues,
 };
 pub use mirror_pairs::{Likeness, MirrorPair, MirrorPlane, mirror_pairs, mirror_plane};
+pub use paired_advantage::{PairedAdvantage, paired_advantage};
 pub use part_cues::{PartCues, PartCuesResult, load_or_compute_part_cues};
 pub use parts_report::PartsReport;
 pub use segment_collection::{
