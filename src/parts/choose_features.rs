@@ -288,8 +288,11 @@ pub(crate) fn choose_features(
     let significance = options.significance;
     let test = advantage.map_or(String::new(), |a| {
         format!(
-            "; per shape the spectral family's advantage is {:+.3} ± {:.3} (standard error over {} shapes, one-sided paired t-test p = {:.3}, level {significance})",
-            a.mean, a.standard_error, a.shapes, a.p_value
+            "; per shape the spectral family's advantage is {:+.3} ± {:.3} (standard error over {} shapes, one-sided paired t-test {}, level {significance})",
+            a.mean,
+            a.standard_error,
+            a.shapes,
+            p_text(a.p_value)
         )
     });
     let case = match frame {
@@ -354,4 +357,13 @@ pub(crate) fn choose_features(
             },
         },
     })
+}
+
+/// A p-value for the reason sentence: three decimals, or `p < 0.001` below what they show.
+fn p_text(p: f64) -> String {
+    if p < 0.001 {
+        "p < 0.001".to_string()
+    } else {
+        format!("p = {p:.3}")
+    }
 }
