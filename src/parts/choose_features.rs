@@ -32,7 +32,7 @@
 use super::aligned_extrinsic_bands::{aligned_extrinsic_bands, concat_tables};
 use super::paired_advantage::{PairedAdvantage, paired_advantage};
 use super::start_score::start_score;
-use crate::align::{AlignOptions, FrameCase, align_collection};
+use crate::align::{AlignError, AlignOptions, CollectionAlignment, FrameCase, align_collection};
 use crate::bands::BandWeighting;
 use crate::features::{ExtrinsicOptions, FamilyWeights, FeatureFamilies};
 use crate::graph::{
@@ -40,6 +40,13 @@ use crate::graph::{
 };
 use crate::mesh::TriMesh;
 use serde::Serialize;
+use std::sync::Arc;
+
+/// A collection alignment the caller makes (or has made) of the same meshes with
+/// [`AlignOptions::default`]: called at most once, when the feature choice needs it, so that a
+/// propagation aligns its collection once for the parts and the rigid route.
+pub(crate) type SharedAlignment<'a> =
+    &'a (dyn Fn() -> Arc<Result<CollectionAlignment, AlignError>> + Sync);
 
 /// Options of [`choose_features`] (the default: `coseg segment` without `--features`).
 #[derive(Debug, Clone, PartialEq)]
@@ -196,12 +203,14 @@ type Candidate = (
 /// (a stool and an armchair moved at random) only in part (docs/ALIGN.md); the shapes it
 /// misplaces weaken the extrinsic candidate, which then loses to the intrinsic one rather
 /// than mislead.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn choose_features(
     nodes: Vec<ShapeNode>,
     meshes: &[TriMesh],
     graph: &GraphOptions,
     cosegment_options: &CosegmentOptions,
     options: &ChooseFeaturesOptions,
+    shared: Option<SharedAlignment<'_>>,
     warnings: &mut Vec<String>,
 ) -> Result<ChosenFeatures, GraphError> {
     let spectral = nodes.first().map_or(0, |n| n.bands.features);
@@ -217,9 +226,15 @@ pub(crate) fn choose_features(
     let mut aligned_scores = Vec::new();
     let mut frame = None;
     let timer = crate::stage_timer::stage("parts: align collection");
-    let aligned = align_collection(meshes, &options.align);
+    // The caller's alignment of these meshes under the default options, when it has one and
+    // those are the options asked for: the same result without aligning twice.
+    let aligned: Arc<Result<CollectionAlignment, AlignError>> =
+        match shared.filter(|_| options.align == AlignOptions::default()) {
+            Some(made) => made(),
+            None => Arc::new(align_collection(meshes, &options.align)),
+        };
     drop(timer);
-    match aligned {
+    match aligned.as_ref() {
         Err(e) => warnings.push(format!(
             "the collection could not be aligned ({e}): the intrinsic family alone is used"
         )),

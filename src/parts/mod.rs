@@ -41,6 +41,7 @@ pub use adaptive_cosegment::{
     adaptive_cosegment, adaptive_update,
 };
 pub use aligned_extrinsic_bands::aligned_extrinsic_bands;
+pub(crate) use choose_features::SharedAlignment;
 pub use choose_features::{ChooseFeaturesOptions, FeatureChoice, FeatureSet};
 pub use choose_part_count::{PartCount, choose_part_count};
 pub use geometric_part_tree::{

@@ -4,7 +4,9 @@
 use super::adaptive_cosegment::{
     AdaptiveCosegmentation, AdaptiveOptions, StopReason, adaptive_cosegment,
 };
-use super::choose_features::{ChooseFeaturesOptions, FeatureChoice, choose_features};
+use super::choose_features::{
+    ChooseFeaturesOptions, FeatureChoice, SharedAlignment, choose_features,
+};
 use super::choose_part_count::{PartCount, choose_part_count};
 use super::geometric_part_tree::geometric_part_tree_linked;
 use super::mirror_pairs::{Likeness, mirror_pairs};
@@ -609,18 +611,22 @@ pub fn segment_collection(
     meshes: &[TriMesh],
     options: &SegmentCollectionOptions,
 ) -> Result<SegmentedCollection, GraphError> {
-    segment_collection_sharing(nodes, meshes, options, None)
+    segment_collection_sharing(nodes, meshes, options, None, None)
 }
 
 /// [`segment_collection`] reading the refinement's heat smoothers from `shared` (one per mesh,
 /// as [`HeatSmoother::new`] makes them) where they have the refinement's smoothing time: the
 /// same result without factorising and holding a second smoother per shape. Smoothers that do
-/// not fit (another time, another vertex count) are ignored and made afresh.
+/// not fit (another time, another vertex count) are ignored and made afresh. `alignment`: the
+/// collection alignment of `meshes` under the default options, made by the caller
+/// ([`SharedAlignment`]), read instead of aligning again when the feature choice aligns with
+/// those options.
 pub(crate) fn segment_collection_sharing(
     nodes: Vec<ShapeNode>,
     meshes: &[TriMesh],
     options: &SegmentCollectionOptions,
     shared: Option<&[HeatSmoother]>,
+    alignment: Option<SharedAlignment<'_>>,
 ) -> Result<SegmentedCollection, GraphError> {
     let smoothing = options
         .refine
@@ -661,6 +667,7 @@ pub(crate) fn segment_collection_sharing(
                 &options.graph,
                 &options.cosegment,
                 c,
+                alignment,
                 &mut warnings,
             )?;
             let mut o = options.clone();

@@ -11,7 +11,8 @@ use crate::mesh::TriMesh;
 use crate::option_range::non_negative;
 use crate::parts::{
     AdaptiveCosegmentation, FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions,
-    SegmentedCollection, StopReason, segment_collection_sharing, snap_part_boundaries,
+    SegmentedCollection, SharedAlignment, StopReason, segment_collection_sharing,
+    snap_part_boundaries,
 };
 use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
@@ -166,12 +167,31 @@ impl CollectionParts {
         meshes: &[TriMesh],
         smoothers: Option<&[HeatSmoother]>,
     ) -> Result<&Cosegmentation, GraphError> {
-        if self.data(meshes, smoothers)?.segmentation.tuples.len() >= count {
+        self.parts_sharing(count, meshes, smoothers, None)
+    }
+
+    /// [`Self::parts_smoothed`] with the collection alignment of `meshes` made by the caller
+    /// ([`SharedAlignment`]; the rigid route's): the same co-segmentation without aligning
+    /// the collection a second time.
+    pub(crate) fn parts_sharing(
+        &mut self,
+        count: usize,
+        meshes: &[TriMesh],
+        smoothers: Option<&[HeatSmoother]>,
+        alignment: Option<SharedAlignment<'_>>,
+    ) -> Result<&Cosegmentation, GraphError> {
+        if self
+            .data(meshes, smoothers, alignment)?
+            .segmentation
+            .tuples
+            .len()
+            >= count
+        {
             // Every tuple is a part to name, the leftovers' too (the tree's cut counts them).
             return Ok(&self.data.as_ref().expect("made above").segmentation);
         }
         if !self.made.contains_key(&count) {
-            let made = self.finer_than(count, meshes, smoothers)?;
+            let made = self.finer_than(count, meshes, smoothers, alignment)?;
             self.made.insert(count, made);
         }
         Ok(&self.made[&count].0)
@@ -186,17 +206,23 @@ impl CollectionParts {
         meshes: &[TriMesh],
         smoothers: Option<&[HeatSmoother]>,
     ) -> Result<&Cosegmentation, GraphError> {
-        Ok(&self.data(meshes, smoothers)?.segmentation)
+        Ok(&self.data(meshes, smoothers, None)?.segmentation)
     }
 
     fn data(
         &mut self,
         meshes: &[TriMesh],
         smoothers: Option<&[HeatSmoother]>,
+        alignment: Option<SharedAlignment<'_>>,
     ) -> Result<&DataParts, GraphError> {
         if self.data.is_none() {
-            let s =
-                segment_collection_sharing(self.nodes.clone(), meshes, &self.options, smoothers)?;
+            let s = segment_collection_sharing(
+                self.nodes.clone(),
+                meshes,
+                &self.options,
+                smoothers,
+                alignment,
+            )?;
             let intrinsic = self.read_intrinsic(&s);
             let tree = s
                 .adaptive
@@ -225,12 +251,13 @@ impl CollectionParts {
         count: usize,
         meshes: &[TriMesh],
         smoothers: Option<&[HeatSmoother]>,
+        alignment: Option<SharedAlignment<'_>>,
     ) -> Result<(Cosegmentation, bool), GraphError> {
         let band = match self.options.parts_from {
             PartsFrom::Geometry { band, .. } => band,
             PartsFrom::Adaptive => 0.0,
         };
-        let data = self.data(meshes, smoothers)?;
+        let data = self.data(meshes, smoothers, alignment)?;
         if let Some(tree) = data.tree.as_ref().filter(|a| a.tree.leaves >= count) {
             let cut = snap_part_boundaries(meshes, &tree.cut(count), band)?;
             return Ok((cut, data.intrinsic));
@@ -246,7 +273,7 @@ impl CollectionParts {
             },
             None,
         );
-        let s = segment_collection_sharing(self.nodes.clone(), meshes, &o, smoothers)?;
+        let s = segment_collection_sharing(self.nodes.clone(), meshes, &o, smoothers, alignment)?;
         let intrinsic = self.read_intrinsic(&s);
         Ok((s.segmentation, intrinsic))
     }
@@ -331,7 +358,10 @@ pub fn fuse_propagation(
     if let (true, Some(parts)) = (options.parts, parts) {
         let count = propagation.parts.len();
         let _t = crate::stage_timer::stage("parts route (co-segmentation)");
-        match parts.parts_smoothed(count, meshes, smoothers) {
+        // The collection alignment the rigid route starts from, made here once for both.
+        let rigid = &propagation.rigid;
+        let alignment = || rigid.alignment(meshes);
+        match parts.parts_sharing(count, meshes, smoothers, Some(&alignment)) {
             Ok(_) => {
                 parts_intrinsic = parts.intrinsic_only(count).unwrap_or(true);
                 let seg = parts.parts(count, meshes)?;

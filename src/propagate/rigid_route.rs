@@ -5,8 +5,9 @@ use super::RouteLabels;
 use super::fuse_routes::cohen_kappa;
 use super::refine_affine::refine_affine;
 use crate::align::{
-    AlignOptions, Candidate, FrameCase, Prepared, RegisterOptions, Registration, Similarity,
-    SurfaceIndex, align_collection, nearest_point_vertex_labels_in, register_onto_from,
+    AlignError, AlignOptions, Candidate, CollectionAlignment, FrameCase, Prepared, RegisterOptions,
+    Registration, Similarity, SurfaceIndex, align_collection, nearest_point_vertex_labels_in,
+    register_onto_from,
 };
 use crate::mesh::TriMesh;
 use nalgebra::Matrix3;
@@ -95,11 +96,14 @@ pub(crate) struct RigidCache {
     frames: Mutex<Option<Arc<CollectionFrames>>>,
 }
 
-/// Per shape its rotation into the collection frame ([`align_collection`]), for the
-/// registrations' first start; `None` when the collection could not be aligned.
+/// The collection alignment ([`align_collection`], default options) and per shape its
+/// rotation into the collection frame, for the registrations' first start (`None` when the
+/// collection could not be aligned). The parts route's feature choice reads the same
+/// alignment ([`RigidCache::alignment`]).
 #[derive(Debug)]
 struct CollectionFrames {
     vertex_counts: Vec<usize>,
+    alignment: Arc<Result<CollectionAlignment, AlignError>>,
     rotations: Option<Vec<Matrix3<f64>>>,
 }
 
@@ -158,31 +162,42 @@ impl RigidCache {
     /// parallel: the alignment runs in parallel itself, and made inside a worker it could
     /// wait on itself.
     fn prepare(&self, meshes: &[TriMesh]) {
+        self.alignment(meshes);
+    }
+
+    /// The collection alignment of `meshes` ([`align_collection`], default options), made on
+    /// the first call (as [`Self::prepare`]) and kept: the rigid route's starts and the parts
+    /// route's feature choice read this one alignment ([`crate::parts::SharedAlignment`]).
+    pub(crate) fn alignment(
+        &self,
+        meshes: &[TriMesh],
+    ) -> Arc<Result<CollectionAlignment, AlignError>> {
         let counts: Vec<usize> = meshes.iter().map(TriMesh::vertex_count).collect();
-        if self
+        if let Some(f) = self
             .lock_frames()
             .as_ref()
-            .is_some_and(|f| f.vertex_counts == counts)
+            .filter(|f| f.vertex_counts == counts)
         {
-            return;
+            return f.alignment.clone();
         }
         let matrix = |r: &[[f64; 3]; 3]| Matrix3::from_fn(|i, j| r[i][j]);
-        let rotations = align_collection(meshes, &AlignOptions::default())
-            .ok()
-            .map(|a| {
-                a.shapes
-                    .iter()
-                    .map(|s| match a.case {
-                        // Bit for bit the files' own frames: the start the route always had.
-                        FrameCase::AlreadyAligned | FrameCase::Single => Matrix3::identity(),
-                        FrameCase::Synchronised => matrix(&s.transform.rotation),
-                    })
-                    .collect()
-            });
+        let alignment = Arc::new(align_collection(meshes, &AlignOptions::default()));
+        let rotations = alignment.as_ref().as_ref().ok().map(|a| {
+            a.shapes
+                .iter()
+                .map(|s| match a.case {
+                    // Bit for bit the files' own frames: the start the route always had.
+                    FrameCase::AlreadyAligned | FrameCase::Single => Matrix3::identity(),
+                    FrameCase::Synchronised => matrix(&s.transform.rotation),
+                })
+                .collect()
+        });
         *self.lock_frames() = Some(Arc::new(CollectionFrames {
             vertex_counts: counts,
+            alignment: alignment.clone(),
             rotations,
         }));
+        alignment
     }
 
     /// The first start of the registration of target `i` onto source `s`: the collection
