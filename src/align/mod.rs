@@ -35,7 +35,7 @@ pub use nearest_point_labels::{nearest_point_labels, nearest_point_vertex_labels
 pub use register_pair::{Candidate, RegisterOptions, Registration, register_pair};
 pub use similarity::Similarity;
 
-pub(crate) use nearest_point_labels::nearest_point_vertex_labels_in;
+pub(crate) use nearest_point_labels::{nearest_corner, nearest_point_vertex_labels_in};
 pub(crate) use register_pair::register_onto_from;
 pub(crate) use surface_samples::Prepared;
 use thiserror::Error;

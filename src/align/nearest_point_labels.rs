@@ -74,13 +74,7 @@ pub(crate) fn nearest_point_vertex_labels_in(
     check_count(source_vertex_labels, source.vertex_count(), "vertex")?;
     let faces = source.faces();
     Ok(nearest(index, target, transform, |c| {
-        let mut k = 0;
-        for i in 1..3 {
-            if c.barycentric[i] > c.barycentric[k] {
-                k = i;
-            }
-        }
-        source_vertex_labels[faces[c.face][k] as usize]
+        source_vertex_labels[nearest_corner(faces, c)]
     }))
 }
 
@@ -95,6 +89,18 @@ fn check_count(labels: &[i32], expected: usize, kind: &'static str) -> Result<()
         });
     }
     Ok(())
+}
+
+/// The source vertex a closest surface point `c` reads its label from: the corner of its face
+/// with the largest barycentric weight (the first of equal ones).
+pub(crate) fn nearest_corner(faces: &[[u32; 3]], c: &SurfacePoint) -> usize {
+    let mut k = 0;
+    for i in 1..3 {
+        if c.barycentric[i] > c.barycentric[k] {
+            k = i;
+        }
+    }
+    faces[c.face][k] as usize
 }
 
 /// Per target vertex (moved by `transform`), the label `label` reads off the closest point

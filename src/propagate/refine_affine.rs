@@ -2,7 +2,7 @@
 //! symmetric ICP, so that shapes of one class with other proportions (a taller back, a wider
 //! seat) overlay part on part.
 
-use crate::align::{Similarity, SurfaceIndex};
+use crate::align::{Similarity, SurfaceIndex, SurfacePoint};
 use crate::mesh::TriMesh;
 use nalgebra::{Matrix3, Vector3};
 use rayon::prelude::*;
@@ -93,12 +93,27 @@ pub fn refine_affine(
     start: &Similarity,
     trim: f64,
 ) -> AffineFit {
+    refine_affine_reading(source, index, target, start, trim).0
+}
+
+/// [`refine_affine`] and, when the returned map is one the iterations paired (not the start
+/// kept because no pairing could be made), the closest source surface point of every target
+/// vertex under it (`index.closest(map.apply(x))`, target order): the rigid route reads its
+/// labels off exactly these points, and they were computed already.
+pub(crate) fn refine_affine_reading(
+    source: &TriMesh,
+    index: &SurfaceIndex,
+    target: &TriMesh,
+    start: &Similarity,
+    trim: f64,
+) -> (AffineFit, Option<Vec<SurfacePoint>>) {
     let ts = target.positions();
     let ss = source.positions();
     let ta = normalised(target.vertex_areas());
     let sa = normalised(source.vertex_areas());
     let mut map = AffineMap::from_similarity(start);
     let mut best: Option<(f64, AffineMap)> = None;
+    let mut best_points: Option<Vec<SurfacePoint>> = None;
     let mut start_residual = f64::INFINITY;
     for it in 0..=ITERATIONS {
         let pairs = correspondences(source, index, target, &map, ts, ss, &ta, &sa, trim);
@@ -110,6 +125,7 @@ pub fn refine_affine(
             break;
         }
         best = Some((pairs.residual, map));
+        best_points = Some(pairs.closest);
         if it == ITERATIONS {
             break;
         }
@@ -119,17 +135,20 @@ pub fn refine_affine(
         }
     }
     let (residual, map) = best.unwrap_or((start_residual, AffineMap::from_similarity(start)));
-    AffineFit {
+    let fit = AffineFit {
         map,
         residual,
         start_residual,
-    }
+    };
+    (fit, best_points)
 }
 
 struct Pairs {
     /// `(target point in target coordinates, source point, weight)`.
     pairs: Vec<([f64; 3], [f64; 3], f64)>,
     residual: f64,
+    /// Per target vertex, its closest source surface point under the map.
+    closest: Vec<SurfacePoint>,
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -145,12 +164,15 @@ fn correspondences(
     trim: f64,
 ) -> Option<Pairs> {
     // Target → source: each target vertex and its nearest source surface point.
-    let forward: Vec<([f64; 3], [f64; 3], f64, f64)> = ts
+    let closest: Vec<SurfacePoint> = ts
         .par_iter()
+        .map(|&x| index.closest(map.apply(x)))
+        .collect();
+    let forward: Vec<([f64; 3], [f64; 3], f64, f64)> = ts
+        .iter()
         .zip(ta)
-        .map(|(&x, &w)| {
-            let y = map.apply(x);
-            let c = index.closest(y);
+        .zip(&closest)
+        .map(|((&x, &w), c)| {
             let p = point_on(source, c.face, c.barycentric);
             (x, p, w, c.distance)
         })
@@ -180,7 +202,11 @@ fn correspondences(
         residual += kept.iter().map(|&k| dir[k].2 * dir[k].3).sum::<f64>() / total / 2.0;
         pairs.extend(kept.iter().map(|&k| (dir[k].0, dir[k].1, dir[k].2 / total)));
     }
-    Some(Pairs { pairs, residual })
+    Some(Pairs {
+        pairs,
+        residual,
+        closest,
+    })
 }
 
 /// Indices of the pairs kept: the nearest ones holding a share `trim` of the weight.

@@ -3,11 +3,11 @@
 
 use super::RouteLabels;
 use super::fuse_routes::cohen_kappa;
-use super::refine_affine::refine_affine;
+use super::refine_affine::refine_affine_reading;
 use crate::align::{
     AlignError, AlignOptions, Candidate, CollectionAlignment, FrameCase, Prepared, RegisterOptions,
-    Registration, Similarity, SurfaceIndex, align_collection, nearest_point_vertex_labels_in,
-    register_onto_from,
+    Registration, Similarity, SurfaceIndex, align_collection, nearest_corner,
+    nearest_point_vertex_labels_in, register_onto_from,
 };
 use crate::mesh::TriMesh;
 use nalgebra::Matrix3;
@@ -306,7 +306,7 @@ impl RigidCache {
             nearest_point_vertex_labels_in(&source.surface, &meshes[s], &index, target, transform)
         };
         let carried = if affine {
-            let fit = refine_affine(
+            let (fit, closest) = refine_affine_reading(
                 &meshes[s],
                 &source.surface,
                 &meshes[i],
@@ -318,9 +318,20 @@ impl RigidCache {
                 // improvement onto the registration's residual.
                 residual = pose.residual * (fit.residual / fit.start_residual).min(1.0);
             }
-            match meshes[i].map_positions(|p| fit.map.apply(p)) {
-                Ok(mapped) => nearest_labels(&mapped, &Similarity::identity()),
-                Err(_) => nearest_labels(&meshes[i], &pose.transform),
+            match closest {
+                // The fit paired every target vertex with its closest source point under the
+                // map it returns: the nearest-point labels of the mapped target, already made.
+                Some(closest) => {
+                    let faces = meshes[s].faces();
+                    Ok(closest
+                        .iter()
+                        .map(|c| (nearest_corner(faces, c) as i32, c.distance))
+                        .unzip())
+                }
+                None => match meshes[i].map_positions(|p| fit.map.apply(p)) {
+                    Ok(mapped) => nearest_labels(&mapped, &Similarity::identity()),
+                    Err(_) => nearest_labels(&meshes[i], &pose.transform),
+                },
             }
         } else {
             nearest_labels(&meshes[i], &pose.transform)
