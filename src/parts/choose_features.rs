@@ -250,7 +250,7 @@ pub(crate) fn choose_features(
             for &reverse in signs {
                 let (tables, up) = match aligned_extrinsic_bands(
                     meshes,
-                    &alignment,
+                    alignment,
                     &options.extrinsic,
                     &band_options,
                     reverse,
