@@ -89,11 +89,17 @@ pub fn collection_views_or_own(meshes: &[TriMesh]) -> (Vec<ViewFrame>, Option<St
         Ok(alignment) => (collection_views(meshes, &alignment), None),
         Err(e) => (
             meshes.iter().map(super::canonical_frame).collect(),
-            Some(format!(
-                "pictures: the collection could not be aligned ({e}); each shape is shown in its own principal frame"
-            )),
+            Some(own_views_warning(&e)),
         ),
     }
+}
+
+/// The warning of pictures drawn in each shape's own view because the collection could not be
+/// aligned (`error`).
+pub fn own_views_warning(error: &crate::align::AlignError) -> String {
+    format!(
+        "pictures: the collection could not be aligned ({error}); each shape is shown in its own principal frame"
+    )
 }
 
 /// The camera's direction (toward the viewer) in the collection frame: from the pooled
