@@ -9,10 +9,12 @@ use std::path::Path;
 /// Earlier stages first. `file_error` (the I/O error every stage reports) depends on nothing.
 /// `vertex_sets` (sorted-set helpers), `labels` (label files) and
 /// `generate` (synthetic inputs) depend only on `mesh`; `cache` only stores entries;
-/// `stage_timer` (the `COSEG_TIMINGS` profile lines) depends on nothing and every stage uses it.
+/// `stage_timer` (the `COSEG_TIMINGS` profile lines) and `option_range` (the range check of
+/// option values) depend on nothing and every stage may use them.
 const ORDER: &[&str] = &[
     "file_error",
     "stage_timer",
+    "option_range",
     "vertex_sets",
     "mesh",
     "labels",
