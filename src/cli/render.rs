@@ -86,7 +86,7 @@ pub fn run(args: RenderArgs) -> Result<ExitCode> {
         all_labels.push(labels);
     }
     // One view for every shape drawn: the collection's own frame.
-    let (views, warning) = collection_views_or_own(&meshes);
+    let (views, warning) = collection_views_or_own(&meshes, None);
     if let Some(w) = warning {
         super::warn(format_args!("{w}"));
     }

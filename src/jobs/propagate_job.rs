@@ -10,9 +10,7 @@ use crate::propagate::{
     PropagateCollectionOptions, PropagateError, PropagatedCollection, SourceFile,
     propagate_collection, propagate_loaded,
 };
-use crate::render::{
-    RenderOptions, RenderShape, canonical_frame, collection_views, own_views_warning,
-};
+use crate::render::{RenderOptions, RenderShape, collection_views_or_own};
 use rayon::prelude::*;
 use std::path::PathBuf;
 
@@ -155,13 +153,8 @@ pub fn run_propagate(
             let _t = crate::stage_timer::stage("pictures");
             // The propagation's own collection alignment (its rigid route's, made once).
             let alignment = result.propagation.rigid.alignment(&result.meshes);
-            let views = match alignment.as_ref() {
-                Ok(a) => collection_views(&result.meshes, a),
-                Err(e) => {
-                    result.warnings.push(own_views_warning(e));
-                    result.meshes.iter().map(canonical_frame).collect()
-                }
-            };
+            let (views, warning) = collection_views_or_own(&result.meshes, Some(&alignment));
+            result.warnings.extend(warning);
             let p = &result.propagation;
             let pictures: Vec<RenderShape> = (0..result.graph.node_count())
                 .map(|i| RenderShape {

@@ -326,7 +326,7 @@ fn draw(
     summary: &CollectionSummary,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<PathBuf>, JobError> {
-    let (views, warning) = collection_views_or_own(meshes);
+    let (views, warning) = collection_views_or_own(meshes, None);
     warnings.extend(warning);
     let pictures: Vec<RenderShape> = shapes
         .iter()

@@ -9,7 +9,7 @@
 
 use super::ViewFrame;
 use super::canonical_view::weighted_centroid;
-use crate::align::{CollectionAlignment, FrameCase};
+use crate::align::{AlignError, CollectionAlignment, FrameCase};
 use crate::mesh::{TriMesh, cross, dot, norm, sub};
 
 /// Azimuth of the camera from the collection's short horizontal axis toward its long one
@@ -54,14 +54,14 @@ pub fn collection_views(meshes: &[TriMesh], alignment: &CollectionAlignment) -> 
         .iter()
         .map(|s| &s.transform.rotation)
         .collect();
-    let centres: Vec<[f64; 3]> = meshes.iter().map(|m| weighted_centroid(m).1).collect();
-    let toward = camera_direction(meshes, &rotations, &centres, up);
+    let weighted: Vec<(Vec<f64>, [f64; 3])> = meshes.iter().map(weighted_centroid).collect();
+    let toward = camera_direction(meshes, &rotations, &weighted, up);
     let screen_up = normalise(sub(up, scale(toward, dot(up, toward))));
     let right = cross(screen_up, toward);
-    centres
+    weighted
         .iter()
         .zip(&rotations)
-        .map(|(&center, r)| {
+        .map(|(&(_, center), r)| {
             // Collection-frame directions into the file: the transpose of the rotation.
             let back = |v: [f64; 3]| {
                 [
@@ -78,28 +78,34 @@ pub fn collection_views(meshes: &[TriMesh], alignment: &CollectionAlignment) -> 
         .collect()
 }
 
-/// [`collection_views`] after aligning `meshes`, or each shape's own
-/// [canonical view](super::canonical_frame) when the alignment fails (with the reason, for a
-/// warning: pictures are an optional stage and never stop a run).
+/// [`collection_views`] of `meshes`, or each shape's own [canonical view](super::canonical_frame)
+/// when the alignment failed (with the reason, for a warning: pictures are an optional stage
+/// and never stop a run).
 ///
-/// Cost: one [`crate::align::align_collection`] with its defaults (about 0.1 s of CPU per
-/// shape, independent of the mesh sizes beyond sampling).
-pub fn collection_views_or_own(meshes: &[TriMesh]) -> (Vec<ViewFrame>, Option<String>) {
-    match crate::align::align_collection(meshes, &crate::align::AlignOptions::default()) {
-        Ok(alignment) => (collection_views(meshes, &alignment), None),
+/// `alignment`: the caller's [`crate::align::align_collection`] of `meshes` with its defaults
+/// when it has one (a propagation's rigid route does); `None` aligns here, about 0.1–0.2 s of
+/// CPU per shape.
+pub fn collection_views_or_own(
+    meshes: &[TriMesh],
+    alignment: Option<&Result<CollectionAlignment, AlignError>>,
+) -> (Vec<ViewFrame>, Option<String>) {
+    let made;
+    let alignment = match alignment {
+        Some(a) => a,
+        None => {
+            made = crate::align::align_collection(meshes, &crate::align::AlignOptions::default());
+            &made
+        }
+    };
+    match alignment {
+        Ok(alignment) => (collection_views(meshes, alignment), None),
         Err(e) => (
             meshes.iter().map(super::canonical_frame).collect(),
-            Some(own_views_warning(&e)),
+            Some(format!(
+                "pictures: the collection could not be aligned ({e}); each shape is shown in its own principal frame"
+            )),
         ),
     }
-}
-
-/// The warning of pictures drawn in each shape's own view because the collection could not be
-/// aligned (`error`).
-pub fn own_views_warning(error: &crate::align::AlignError) -> String {
-    format!(
-        "pictures: the collection could not be aligned ({error}); each shape is shown in its own principal frame"
-    )
 }
 
 /// The camera's direction (toward the viewer) in the collection frame: from the pooled
@@ -107,7 +113,7 @@ pub fn own_views_warning(error: &crate::align::AlignError) -> String {
 fn camera_direction(
     meshes: &[TriMesh],
     rotations: &[&[[f64; 3]; 3]],
-    centres: &[[f64; 3]],
+    weighted: &[(Vec<f64>, [f64; 3])],
     up: [f64; 3],
 ) -> [f64; 3] {
     // Two horizontal axes: any pair orthogonal to up, then turned onto the principal axes.
@@ -118,23 +124,24 @@ fn camera_direction(
     };
     let h0 = normalise(cross(helper, up));
     let h1 = cross(up, h0);
-    // Per shape: its points centred, rotated into the collection frame, in (h0, h1); the
-    // second and third moments pooled with one weight per shape.
-    let mut m2 = [0.0; 3];
-    let mut samples: Vec<(f64, f64, f64)> = Vec::new();
-    for ((mesh, r), c) in meshes.iter().zip(rotations).zip(centres) {
-        let (w, _) = weighted_centroid(mesh);
-        let total: f64 = w.iter().sum();
-        for (p, &wi) in mesh.positions().iter().zip(&w) {
-            let d = sub(*p, *c);
-            let q = [dot(r[0], d), dot(r[1], d), dot(r[2], d)];
-            let (a, b, wi) = (dot(q, h0), dot(q, h1), wi / total);
-            m2[0] += wi * a * a;
-            m2[1] += wi * a * b;
-            m2[2] += wi * b * b;
-            samples.push((a, b, wi));
+    // Every vertex's (h0, h1) coordinates after centring its shape and rotating it into the
+    // collection frame, with its weight (one equal weight per shape), in mesh order.
+    let for_each = |f: &mut dyn FnMut(f64, f64, f64)| {
+        for ((mesh, r), (w, c)) in meshes.iter().zip(rotations).zip(weighted) {
+            let total: f64 = w.iter().sum();
+            for (p, &wi) in mesh.positions().iter().zip(w) {
+                let d = sub(*p, *c);
+                let q = [dot(r[0], d), dot(r[1], d), dot(r[2], d)];
+                f(dot(q, h0), dot(q, h1), wi / total);
+            }
         }
-    }
+    };
+    let mut m2 = [0.0; 3];
+    for_each(&mut |a, b, w| {
+        m2[0] += w * a * a;
+        m2[1] += w * a * b;
+        m2[2] += w * b * b;
+    });
     // Long axis of the 2 × 2 spread: the angle ½·atan2(2 m_ab, m_aa − m_bb) from h0.
     let theta = 0.5 * (2.0 * m2[1]).atan2(m2[0] - m2[2]);
     let long = add(scale(h0, theta.cos()), scale(h1, theta.sin()));
@@ -142,12 +149,12 @@ fn camera_direction(
     let lean = |axis: [f64; 3]| {
         let (a, b) = (dot(axis, h0), dot(axis, h1));
         let (mut s2, mut s3, mut sw) = (0.0, 0.0, 0.0);
-        for &(x, y, w) in &samples {
+        for_each(&mut |x, y, w| {
             let t = a * x + b * y;
             s2 += w * t * t;
             s3 += w * t * t * t;
             sw += w;
-        }
+        });
         let sigma = (s2 / sw.max(f64::MIN_POSITIVE)).sqrt();
         if s3.abs() > NO_LEAN * sw * sigma.powi(3) {
             s3.signum()

@@ -26,7 +26,7 @@ mod rasterise;
 mod region_colors;
 
 pub use canonical_view::{ViewFrame, canonical_frame};
-pub use collection_view::{collection_views, collection_views_or_own, own_views_warning};
+pub use collection_view::{collection_views, collection_views_or_own};
 pub(crate) use contact_sheet::labels_present;
 pub use contact_sheet::{RenderOptions, RenderShape, render_shape, render_sheet, write_pictures};
 pub use font::{draw_text, text_width};
