@@ -28,6 +28,7 @@
 //! | `<key>.coseg-shape` ([`EntryKind::Full`]) | [`crate::pipeline::StoredShape`] | eigenvalues (f64), eigenvectors (**f32**, `d × k`), vertex areas (f64), the sdf and user feature columns (f64) when those families are on, band table (u8 `d × N`, deflated inside the payload) | `4·d·k + 8·d + d·N/6` (10k vertices: 8.6 MB) |
 //! | `<key>.coseg-bands` ([`EntryKind::Bands`]) | [`crate::pipeline::ShapeBands`] | band table (u8, `d × N`), vertex areas (f64), the whole payload deflated | about `d·N / 6 + 8·d` (10k: 0.5 MB) |
 //! | `<key>.coseg-cues` ([`EntryKind::PartCues`], only with `--parts-from geometry`; key: the mesh and the SDF options, not the feature options) | [`crate::parts::PartCues`] | thickness and mean curvature (f64) | `16·d` (10k: 0.16 MB) |
+//! | `<key>.coseg-tree` ([`EntryKind::PartTree`], one per collection, with parts from geometry; key: [`crate::parts::part_tree_key`]) | the part tree of [`crate::parts::segment_collection_cached`] | the leaves' vertex lists (u32), the tree, the feature choice, the extrinsic band tables when chosen (u8), the whole payload deflated | about `4·Σd` + `Σd·E/6` (E extrinsic columns) |
 //!
 //! The descriptors (spectral and extrinsic) are not in the full entry: a warm load recomputes
 //! them from the stored spectrum with the cold run's own code
@@ -55,6 +56,8 @@ pub const CACHE_EXTENSION: &str = "coseg-shape";
 pub const BANDS_EXTENSION: &str = "coseg-bands";
 /// File extension of the part-cue entries ([`EntryKind::PartCues`]).
 pub const CUES_EXTENSION: &str = "coseg-cues";
+/// File extension of the part-tree entries ([`EntryKind::PartTree`]).
+pub const PART_TREE_EXTENSION: &str = "coseg-tree";
 /// Deflate level of compressed payloads ([`EntryKind::compressed`]).
 const DEFLATE_LEVEL: u32 = 3;
 /// Deflate's largest expansion (a run of one byte: 258 bytes per 2-bit code, about 1032:1),
@@ -72,6 +75,10 @@ pub enum EntryKind {
     /// The geometric cues of part boundaries ([`crate::parts::PartCues`]: thickness and mean
     /// curvature per vertex), for `--parts-from geometry`; keyed by the mesh alone.
     PartCues,
+    /// A collection's part tree, what `coseg segment` cuts at any number of parts
+    /// ([`crate::parts::segment_collection_cached`]); keyed by every shape's key and the
+    /// collection stage's options but the number of parts.
+    PartTree,
 }
 
 impl EntryKind {
@@ -81,6 +88,7 @@ impl EntryKind {
             EntryKind::Full => b"COSEGSHP",
             EntryKind::Bands => b"COSEGBND",
             EntryKind::PartCues => b"COSEGCUE",
+            EntryKind::PartTree => b"COSEGTRE",
         }
     }
 
@@ -90,15 +98,16 @@ impl EntryKind {
             EntryKind::Full => CACHE_EXTENSION,
             EntryKind::Bands => BANDS_EXTENSION,
             EntryKind::PartCues => CUES_EXTENSION,
+            EntryKind::PartTree => PART_TREE_EXTENSION,
         }
     }
 
     /// True when the whole payload of such a file is deflate-compressed (see the module
     /// docs): the compact entry is mostly its band table, which shrinks about 6× for a few ms
-    /// per read. The full entry deflates only its band table: its `f32` eigenvectors would
+    /// per read; the part tree is mostly vertex lists and the extrinsic band tables. The full entry deflates only its band table: its `f32` eigenvectors would
     /// shrink by 7 % (16 % with a byte shuffle) for a quarter of a second per write.
     pub fn compressed(self) -> bool {
-        matches!(self, EntryKind::Bands)
+        matches!(self, EntryKind::Bands | EntryKind::PartTree)
     }
 }
 

@@ -248,6 +248,12 @@ fn report(args: &SegmentArgs, outcome: &SegmentOutcome, t0: Instant) {
         outcome.written.len(),
         args.out.display()
     );
+    if outcome.part_tree_cache == Some(CacheOutcome::Hit) {
+        println!(
+            "collection stage: re-cut from the cache (the part tree of an earlier run on these shapes and options, cut at {} parts)",
+            seg.tuples.len()
+        );
+    }
     let times = &result.times;
     println!(
         "time: read {:.2} s, per-shape data {:.2} s ({hits} cached), {}graph {:.2} s, co-segmentation {:.2} s{}, refinement {:.2} s{}, write {:.2} s, total {:.2} s",

@@ -6,8 +6,11 @@ use crate::cache::CacheOutcome;
 use crate::graph::load_collection;
 use crate::mesh::TriMesh;
 use crate::output::{CollectionSummary, ShapeRegions, SkippedInput, write_regions, write_visuals};
-use crate::parts::{PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentedCollection};
-use crate::pipeline::ShapePipelineOptions;
+use crate::parts::{
+    PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentedCollection, segment_collection,
+    segment_collection_cached,
+};
+use crate::pipeline::{ShapePipelineOptions, shape_key};
 use crate::render::{RenderOptions, RenderShape, collection_views_or_own};
 use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
@@ -134,6 +137,10 @@ pub struct SegmentOutcome {
     pub skipped: Vec<SkippedInput>,
     /// Where each shape's data came from (graph order; `None`: computed without a cache).
     pub cache_outcomes: Vec<Option<CacheOutcome>>,
+    /// Where the part tree came from ([`crate::parts::segment_collection_cached`]):
+    /// [`CacheOutcome::Hit`] when it was read from the cache and only re-cut; `None` without a
+    /// cache or in a mode without a part tree (equal-area regions, adaptive parts).
+    pub part_tree_cache: Option<CacheOutcome>,
     /// Warnings for the user: the meshes', the cache's, the stages', the parts'.
     pub warnings: Vec<String>,
     /// Time spent reading meshes and in the per-shape stage, summed over shapes (across
@@ -170,7 +177,9 @@ pub enum SegmentProgress<'a> {
 }
 
 /// Consistent co-segmentation of a collection, from the inputs to the written result: the
-/// per-shape stage of every shape (through the cache), [`crate::parts::segment_collection`],
+/// per-shape stage of every shape (through the cache), [`crate::parts::segment_collection`]
+/// (with a cache, through [`crate::parts::segment_collection_cached`]: a part tree grown by an
+/// earlier run on the same shapes and options, whatever its number of parts, is only re-cut),
 /// `summary.json`, the region files and, if asked, the pictures.
 ///
 /// - `input`: a folder, or shapes;
@@ -263,12 +272,22 @@ pub fn run_segment_with_progress(
         times,
     } = loaded;
     check_count(nodes.len())?;
+    let cache_dir = cue_cache.clone();
     let options = job.collection_options(nodes[0].bands.features, cue_cache)?;
     progress(SegmentProgress::Stage("co-segmentation and refinement"));
-    let result = crate::parts::segment_collection(nodes, &meshes, &options)?;
+    let (result, part_tree_cache) = match &cache_dir {
+        Some(dir) => {
+            let keys: Vec<_> = meshes.iter().map(|m| shape_key(m, &job.pipeline)).collect();
+            segment_collection_cached(nodes, &meshes, &options, dir, &keys)?
+        }
+        None => (segment_collection(nodes, &meshes, &options)?, None),
+    };
     warnings.extend(result.warnings.iter().cloned());
     let mut summary = CollectionSummary::new(&result, &files, &options, skipped.clone());
     summary.parts = result.parts_report(&meshes);
+    if part_tree_cache == Some(CacheOutcome::Hit) {
+        summary.collection_stage = Some(RECUT);
+    }
     warnings.extend(summary.parts.as_ref().and_then(|p| p.warning()));
     let seg = &result.segmentation;
     let labels: Vec<Vec<i32>> = (0..seg.names.len()).map(|i| seg.labels(i)).collect();
@@ -291,12 +310,16 @@ pub fn run_segment_with_progress(
         labels,
         skipped,
         cache_outcomes: outcomes,
+        part_tree_cache,
         warnings,
         load_times: times,
         write_time: t_write.elapsed(),
         written,
     })
 }
+
+/// `summary.json`'s `collection_stage` when the part tree was read from the cache.
+const RECUT: &str = "recut";
 
 /// The shapes a run segments, before the co-segmentation.
 struct Loaded {

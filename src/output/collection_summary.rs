@@ -110,6 +110,11 @@ pub struct CollectionSummary {
     /// equal-area regions).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub part_count: Option<crate::parts::PartCount>,
+    /// `"recut"` when the part tree was read from the cache (an earlier run on the same shapes
+    /// and options, another number of parts) and only cut; absent when it was grown. The one
+    /// field in which a re-cut's file differs from a cold run's.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub collection_stage: Option<&'static str>,
 }
 
 /// Which of several co-segmentation starts was kept ([`SegmentCollectionOptions::starts`]).
@@ -205,6 +210,7 @@ impl CollectionSummary {
             }),
             features: result.features.clone(),
             part_count: result.part_count.clone(),
+            collection_stage: None,
         }
     }
 }

@@ -16,6 +16,9 @@
 //!   (and mirror pairs) of one thickness, read from each shape's [`PartCues`].
 //! - [`snap_part_boundaries`]: the parts' boundaries moved onto creases.
 //! - [`PartsReport`]: what `summary.json` records of a parts run.
+//! - [`part_tree`] and [`cut_part_tree`]: parts from geometry in two steps, the tree (the
+//!   costly part) and its cut; [`segment_collection_cached`] keeps the tree in the cache, so
+//!   that another number of parts only re-cuts.
 //!
 //! Errors are the collection stage's [`GraphError`](crate::graph::GraphError).
 
@@ -27,6 +30,7 @@ mod geometric_part_tree;
 mod mirror_pairs;
 mod paired_advantage;
 mod part_cues;
+mod part_tree_cache;
 mod parts_report;
 mod segment_collection;
 mod snap_part_boundaries;
@@ -50,10 +54,11 @@ pub use geometric_part_tree::{
 pub use mirror_pairs::{Likeness, MirrorPair, MirrorPlane, mirror_pairs, mirror_plane};
 pub use paired_advantage::{PairedAdvantage, paired_advantage};
 pub use part_cues::{PartCues, PartCuesResult, load_or_compute_part_cues};
+pub use part_tree_cache::{part_tree_key, segment_collection_cached};
 pub use parts_report::PartsReport;
 pub use segment_collection::{
-    FeatureSelection, PartsFrom, PartsRequest, SegmentCollectionOptions, SegmentTimes,
-    SegmentedCollection, segment_collection,
+    FeatureSelection, PartTreeStage, PartsFrom, PartsRequest, SegmentCollectionOptions,
+    SegmentTimes, SegmentedCollection, cut_part_tree, part_tree, segment_collection,
 };
 pub(crate) use segment_collection::{GEOMETRY_LEAVES, segment_collection_sharing};
 pub use snap_part_boundaries::snap_part_boundaries;

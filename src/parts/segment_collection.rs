@@ -614,20 +614,88 @@ pub fn segment_collection(
     segment_collection_sharing(nodes, meshes, options, None, None)
 }
 
-/// [`segment_collection`] reading the refinement's heat smoothers from `shared` (one per mesh,
-/// as [`HeatSmoother::new`] makes them) where they have the refinement's smoothing time: the
-/// same result without factorising and holding a second smoother per shape. Smoothers that do
-/// not fit (another time, another vertex count) are ignored and made afresh. `alignment`: the
-/// collection alignment of `meshes` under the default options, made by the caller
-/// ([`SharedAlignment`]), read instead of aligning again when the feature choice aligns with
-/// those options.
-pub(crate) fn segment_collection_sharing(
+/// The collection stage of parts from geometry up to the cut ([`part_tree`]): the shape graph,
+/// the leaves and the part tree over them, and what the feature choice decided. Cut at any
+/// number of parts by [`cut_part_tree`]; `coseg segment` keeps it in its cache
+/// ([`super::segment_collection_cached`]) so that another `--parts N` only re-cuts.
+#[derive(Debug, Clone)]
+#[non_exhaustive]
+pub struct PartTreeStage {
+    /// The shape graph the leaves were co-segmented on.
+    pub graph: ShapeGraph,
+    /// The leaves (the refined equal-area regions split into their kinds of pieces) and the
+    /// part tree over them ([`StopReason::EqualAreaLeaves`], no adaptive tuples).
+    pub tree: AdaptiveCosegmentation,
+    /// The feature families chosen from the data, and why (`None`: the columns as given).
+    pub features: Option<FeatureChoice>,
+    /// The up direction the co-segmentation's options held after the feature choice
+    /// ([`SegmentCollectionOptions::up`]).
+    pub up: Option<[f64; 3]>,
+    /// Likewise, the mirror-invariant columns ([`SegmentCollectionOptions::mirror_columns`]).
+    pub mirror_columns: Vec<usize>,
+    /// Likewise, the per-feature weights ([`SegmentCollectionOptions::feature_weights`]).
+    pub feature_weights: Option<Vec<f64>>,
+    /// Warnings about the result (an alignment or extrinsic family that could not be
+    /// computed), for the user with every cut.
+    pub warnings: Vec<String>,
+    /// Warnings about this run alone (part-cue cache entries not trusted or not written).
+    pub run_warnings: Vec<String>,
+    /// Per-stage wall times so far.
+    pub times: SegmentTimes,
+}
+
+/// The shape graph, the options after the feature choice, and what the stages before the
+/// co-segmentation made.
+struct Prepared<'a> {
+    graph: ShapeGraph,
+    options: SegmentCollectionOptions,
+    features: Option<FeatureChoice>,
+    warnings: Vec<String>,
+    /// How many of `warnings` are the feature choice's (about the result); the rest are the
+    /// part cues' (about the run).
+    feature_warnings: usize,
+    times: SegmentTimes,
+    shared: Option<&'a [HeatSmoother]>,
+    made: Option<Vec<HeatSmoother>>,
+    cues: Option<Vec<super::PartCues>>,
+    geometry: Option<(usize, Result<usize, usize>, f64)>,
+}
+
+/// With parts from geometry: `(leaves, Ok(parts) or Err(upper bound on the chosen number),
+/// band)`, the options checked; `None` in the other modes.
+fn geometry_mode(
+    options: &SegmentCollectionOptions,
+) -> Result<Option<(usize, Result<usize, usize>, f64)>, GraphError> {
+    match (&options.parts, options.parts_from) {
+        (None, PartsFrom::Geometry { .. }) => Err(GraphError::BadOption(
+            "parts from geometry need a number of parts (--parts N)".into(),
+        )),
+        (Some(p), PartsFrom::Geometry { leaves, band }) => {
+            if let Some(parts) = p.parts
+                && leaves < parts
+            {
+                return Err(GraphError::BadOption(format!(
+                    "parts from geometry: {leaves} regions cannot make {parts} parts"
+                )));
+            }
+            check_band(band)?;
+            // Without a number of parts, the tree's cut criterion chooses one, at most the
+            // upper bound (`--regions` with `--parts auto`).
+            Ok(Some((leaves, p.parts.ok_or(p.max_parts), band)))
+        }
+        _ => Ok(None),
+    }
+}
+
+/// The stages before the co-segmentation: options checked, feature families chosen (or the
+/// graph built over the columns as given), heat smoothers, part cues.
+fn prepare<'a>(
     nodes: Vec<ShapeNode>,
     meshes: &[TriMesh],
     options: &SegmentCollectionOptions,
-    shared: Option<&[HeatSmoother]>,
+    shared: Option<&'a [HeatSmoother]>,
     alignment: Option<SharedAlignment<'_>>,
-) -> Result<SegmentedCollection, GraphError> {
+) -> Result<Prepared<'a>, GraphError> {
     let smoothing = options
         .refine
         .as_ref()
@@ -658,7 +726,7 @@ pub(crate) fn segment_collection_sharing(
         }
         _ => None,
     };
-    let (graph, chosen_options, features) = match choose {
+    let (graph, options, features) = match choose {
         Some(c) => {
             let _t = crate::stage_timer::stage("parts: choose features");
             let chosen = choose_features(
@@ -675,7 +743,7 @@ pub(crate) fn segment_collection_sharing(
             o.up = chosen.up;
             o.mirror_columns = chosen.mirror_columns;
             times.features = Some(t.elapsed());
-            (chosen.graph, Some(o), Some(chosen.choice))
+            (chosen.graph, o, Some(chosen.choice))
         }
         None => {
             let mut graph = ShapeGraph::build(nodes, &options.graph)?;
@@ -683,10 +751,10 @@ pub(crate) fn segment_collection_sharing(
                 graph.set_feature_weights(options.feature_weights.clone())?;
             }
             times.graph = t.elapsed();
-            (graph, None, None)
+            (graph, options.clone(), None)
         }
     };
-    let options = chosen_options.as_ref().unwrap_or(options);
+    let feature_warnings = warnings.len();
     if options.starts == 0 {
         return Err(GraphError::BadOption("starts must be at least 1".into()));
     }
@@ -697,27 +765,7 @@ pub(crate) fn segment_collection_sharing(
         )));
     }
     let refine = options.refine.as_ref().filter(|r| r.max_rounds > 0);
-    let geometry = match (&options.parts, options.parts_from) {
-        (None, PartsFrom::Geometry { .. }) => {
-            return Err(GraphError::BadOption(
-                "parts from geometry need a number of parts (--parts N)".into(),
-            ));
-        }
-        (Some(p), PartsFrom::Geometry { leaves, band }) => {
-            if let Some(parts) = p.parts
-                && leaves < parts
-            {
-                return Err(GraphError::BadOption(format!(
-                    "parts from geometry: {leaves} regions cannot make {parts} parts"
-                )));
-            }
-            check_band(band)?;
-            // Without a number of parts, the tree's cut criterion chooses one, at most the
-            // upper bound (`--regions` with `--parts auto`).
-            Some((leaves, p.parts.ok_or(p.max_parts), band))
-        }
-        _ => None,
-    };
+    let geometry = geometry_mode(&options)?;
     let t = Instant::now();
     let timer = crate::stage_timer::stage("parts: heat smoothers");
     let fits = |r: &RefineOptions, s: &[HeatSmoother]| {
@@ -745,7 +793,6 @@ pub(crate) fn segment_collection_sharing(
         ),
         _ => None,
     };
-    let smoothers: Option<&[HeatSmoother]> = shared.or(made.as_deref());
     times.smoothers = t.elapsed();
     drop(timer);
     let cues = match geometry {
@@ -764,31 +811,71 @@ pub(crate) fn segment_collection_sharing(
         }
         None => None,
     };
+    Ok(Prepared {
+        graph,
+        options,
+        features,
+        warnings,
+        feature_warnings,
+        times,
+        shared,
+        made,
+        cues,
+        geometry,
+    })
+}
+
+/// [`segment_collection`] reading the refinement's heat smoothers from `shared` (one per mesh,
+/// as [`HeatSmoother::new`] makes them) where they have the refinement's smoothing time: the
+/// same result without factorising and holding a second smoother per shape. Smoothers that do
+/// not fit (another time, another vertex count) are ignored and made afresh. `alignment`: the
+/// collection alignment of `meshes` under the default options, made by the caller
+/// ([`SharedAlignment`]), read instead of aligning again when the feature choice aligns with
+/// those options.
+pub(crate) fn segment_collection_sharing(
+    nodes: Vec<ShapeNode>,
+    meshes: &[TriMesh],
+    options: &SegmentCollectionOptions,
+    shared: Option<&[HeatSmoother]>,
+    alignment: Option<SharedAlignment<'_>>,
+) -> Result<SegmentedCollection, GraphError> {
+    let prepared = prepare(nodes, meshes, options, shared, alignment)?;
+    if prepared.geometry.is_some() {
+        let stage = grow_part_tree(prepared, meshes)?;
+        return cut_part_tree(stage, meshes, options);
+    }
+    let Prepared {
+        graph,
+        options,
+        features,
+        warnings,
+        mut times,
+        shared,
+        made,
+        ..
+    } = prepared;
+    let smoothers = shared.or(made.as_deref());
+    let graph = &graph;
+    let refine = options.refine.as_ref().filter(|r| r.max_rounds > 0);
     let mut best: Option<(f64, usize, Cosegmentation, Option<AdaptiveCosegmentation>)> = None;
-    let mut part_count = None;
     let mut start_scores = Vec::with_capacity(options.starts);
     for start in 0..options.starts {
         let t = Instant::now();
         let timer = crate::stage_timer::stage("parts: cosegment");
-        let (mut segmentation, mut adaptive) = match (&options.parts, geometry) {
-            (_, Some((leaves, _, _))) => {
-                let mut o = options.cosegment;
-                o.regions = leaves;
-                (cosegment(&graph, &o)?, None)
-            }
-            (None, None) => {
+        let (mut segmentation, adaptive) = match &options.parts {
+            None => {
                 let mut o = options.cosegment;
                 if start > 0 {
                     o.seed = Some(o.seed.unwrap_or(0) + start as u64);
                 }
-                (cosegment(&graph, &o)?, None)
+                (cosegment(graph, &o)?, None)
             }
-            (Some(p), None) => {
-                let mut a = adaptive_cosegment(&graph, p)?;
+            Some(p) => {
+                let mut a = adaptive_cosegment(graph, p)?;
                 if options.group_mirrors {
-                    let pairs = mirror_links(&graph, meshes, &a.leaves, options);
+                    let pairs = mirror_links(graph, meshes, &a.leaves, &options);
                     if !pairs.is_empty() {
-                        a.regroup(&graph, &pairs);
+                        a.regroup(graph, &pairs);
                     }
                 }
                 (a.cut(p.parts.unwrap_or(usize::MAX)), Some(a))
@@ -799,60 +886,14 @@ pub(crate) fn segment_collection_sharing(
         if let Some(refine) = refine {
             let t = Instant::now();
             let _t = crate::stage_timer::stage("parts: refine");
-            // Equal-area leaves have no sizes from the data to keep.
-            let sizes = match geometry {
-                Some(_) => RefineSizes::Free,
-                None => options.refine_sizes,
-            };
-            segmentation =
-                refine_cosegmentation_sized(&graph, &segmentation, smoothers, refine, sizes)?;
+            segmentation = refine_cosegmentation_sized(
+                graph,
+                &segmentation,
+                smoothers,
+                refine,
+                options.refine_sizes,
+            )?;
             times.refine += t.elapsed();
-        }
-        // Parts from geometry: the refined equal-area regions, split into their kinds of
-        // pieces, are the leaves, cut after their refinement (a refinement of the grouped
-        // parts would drift them back to equal areas); then the parts' boundaries, still the
-        // leaves', move onto the creases between parts.
-        if let Some((_, parts, band)) = geometry {
-            let t = Instant::now();
-            let _t = crate::stage_timer::stage("parts: geometric tree and snapping");
-            let regions = segmentation.tuples.len();
-            let split = split_disconnected_leaves(meshes, &segmentation)?;
-            let siblings = split.siblings();
-            // Recorded only when a region was split: otherwise every leaf is its own.
-            let leaf_origin = if split.origin.len() > regions {
-                split.origin
-            } else {
-                Vec::new()
-            };
-            segmentation = split.segmentation;
-            // Siblings facing the same way are copies of one part (a chair's front and back
-            // legs): linked like mirror pairs, at no extra cost.
-            let mut links = mirror_links(&graph, meshes, &segmentation, options);
-            links.extend_from_slice(&split.alike);
-            let cues = cues
-                .as_deref()
-                .expect("computed above with parts from geometry");
-            let tree = geometric_part_tree_linked(meshes, cues, &segmentation, &links, &siblings)?;
-            let parts = match parts {
-                Ok(k) => k,
-                Err(max_parts) => {
-                    let c = choose_part_count(&tree, max_parts);
-                    let k = c.count;
-                    part_count = Some(c);
-                    k
-                }
-            };
-            let a = AdaptiveCosegmentation {
-                leaves: segmentation,
-                auto: Vec::new(),
-                stop: StopReason::EqualAreaLeaves,
-                tree,
-                leaf_origin,
-                leaf_copies: split.alike,
-            };
-            segmentation = snap_part_boundaries(meshes, &a.cut(parts), band)?;
-            adaptive = Some(a);
-            times.cosegment += t.elapsed();
         }
         let score = start_score(&segmentation);
         start_scores.push(score);
@@ -862,14 +903,174 @@ pub(crate) fn segment_collection_sharing(
     }
     let (_, start, segmentation, adaptive) = best.expect("at least one start");
     Ok(SegmentedCollection {
-        graph,
+        graph: graph.clone(),
         segmentation,
         times,
         adaptive,
         start,
         start_scores,
         up: options.up,
-        mirror_columns: options.mirror_columns.clone(),
+        mirror_columns: options.mirror_columns,
+        warnings,
+        features,
+        part_count: None,
+    })
+}
+
+/// Parts from geometry up to the cut: the equal-area leaves, refined, split into their kinds
+/// of pieces, and the part tree over them.
+fn grow_part_tree(prepared: Prepared<'_>, meshes: &[TriMesh]) -> Result<PartTreeStage, GraphError> {
+    let Prepared {
+        graph,
+        options,
+        features,
+        mut warnings,
+        feature_warnings,
+        mut times,
+        shared,
+        made,
+        cues,
+        geometry,
+    } = prepared;
+    let (leaves, _, _) = geometry.expect("parts from geometry");
+    let smoothers = shared.or(made.as_deref());
+    let t = Instant::now();
+    let timer = crate::stage_timer::stage("parts: cosegment");
+    let mut o = options.cosegment;
+    o.regions = leaves;
+    let mut segmentation = cosegment(&graph, &o)?;
+    times.cosegment += t.elapsed();
+    drop(timer);
+    if let Some(refine) = options.refine.as_ref().filter(|r| r.max_rounds > 0) {
+        let t = Instant::now();
+        let _t = crate::stage_timer::stage("parts: refine");
+        // Equal-area leaves have no sizes from the data to keep.
+        segmentation = refine_cosegmentation_sized(
+            &graph,
+            &segmentation,
+            smoothers,
+            refine,
+            RefineSizes::Free,
+        )?;
+        times.refine += t.elapsed();
+    }
+    // The refined equal-area regions, split into their kinds of pieces, are the leaves, cut
+    // after their refinement (a refinement of the grouped parts would drift them back to equal
+    // areas); then [`cut_part_tree`] moves the parts' boundaries, still the leaves', onto the
+    // creases between parts.
+    let t = Instant::now();
+    let _t = crate::stage_timer::stage("parts: geometric tree");
+    let regions = segmentation.tuples.len();
+    let split = split_disconnected_leaves(meshes, &segmentation)?;
+    let siblings = split.siblings();
+    // Recorded only when a region was split: otherwise every leaf is its own.
+    let leaf_origin = if split.origin.len() > regions {
+        split.origin
+    } else {
+        Vec::new()
+    };
+    let segmentation = split.segmentation;
+    // Siblings facing the same way are copies of one part (a chair's front and back legs):
+    // linked like mirror pairs, at no extra cost.
+    let mut links = mirror_links(&graph, meshes, &segmentation, &options);
+    links.extend_from_slice(&split.alike);
+    let cues = cues
+        .as_deref()
+        .expect("computed above with parts from geometry");
+    let tree = geometric_part_tree_linked(meshes, cues, &segmentation, &links, &siblings)?;
+    times.cosegment += t.elapsed();
+    let run_warnings = warnings.split_off(feature_warnings);
+    Ok(PartTreeStage {
+        graph,
+        tree: AdaptiveCosegmentation {
+            leaves: segmentation,
+            auto: Vec::new(),
+            stop: StopReason::EqualAreaLeaves,
+            tree,
+            leaf_origin,
+            leaf_copies: split.alike,
+        },
+        features,
+        up: options.up,
+        mirror_columns: options.mirror_columns,
+        feature_weights: options.feature_weights,
+        warnings,
+        run_warnings,
+        times,
+    })
+}
+
+/// Parts from geometry (the default of [`segment_collection`]) up to the cut: the collection
+/// stage's costly part, whatever the number of parts. [`cut_part_tree`] then cuts it;
+/// [`segment_collection`] is the two in a row.
+///
+/// Errors: those of [`segment_collection`], and [`GraphError::BadOption`] when the options do
+/// not ask for parts from geometry.
+pub fn part_tree(
+    nodes: Vec<ShapeNode>,
+    meshes: &[TriMesh],
+    options: &SegmentCollectionOptions,
+) -> Result<PartTreeStage, GraphError> {
+    let prepared = prepare(nodes, meshes, options, None, None)?;
+    if prepared.geometry.is_none() {
+        return Err(GraphError::BadOption(
+            "a part tree is grown for parts from geometry (--parts-from geometry)".into(),
+        ));
+    }
+    grow_part_tree(prepared, meshes)
+}
+
+/// Cuts `stage` as `options` ask: at [`AdaptiveOptions::parts`], or where
+/// [`super::choose_part_count`] chooses (at most [`AdaptiveOptions::max_parts`]), then moves
+/// the parts' boundaries onto creases within the band of [`PartsFrom::Geometry`]
+/// ([`super::snap_part_boundaries`]). `meshes`: the shapes `stage` was grown on (graph order).
+/// The result is [`segment_collection`]'s for the same nodes and options, bit for bit.
+///
+/// Errors: [`GraphError::BadOption`] when `options` do not ask for parts from geometry or ask
+/// for more parts than leaves; those of [`super::snap_part_boundaries`].
+pub fn cut_part_tree(
+    stage: PartTreeStage,
+    meshes: &[TriMesh],
+    options: &SegmentCollectionOptions,
+) -> Result<SegmentedCollection, GraphError> {
+    let Some((_, parts, band)) = geometry_mode(options)? else {
+        return Err(GraphError::BadOption(
+            "a part tree is cut for parts from geometry (--parts-from geometry)".into(),
+        ));
+    };
+    let PartTreeStage {
+        graph,
+        tree,
+        features,
+        up,
+        mirror_columns,
+        mut warnings,
+        run_warnings,
+        mut times,
+        ..
+    } = stage;
+    let t = Instant::now();
+    let _t = crate::stage_timer::stage("parts: cut and snapping");
+    let (parts, part_count) = match parts {
+        Ok(k) => (k, None),
+        Err(max_parts) => {
+            let c = choose_part_count(&tree.tree, max_parts);
+            (c.count, Some(c))
+        }
+    };
+    let segmentation = snap_part_boundaries(meshes, &tree.cut(parts), band)?;
+    times.cosegment += t.elapsed();
+    warnings.extend(run_warnings);
+    let score = start_score(&segmentation);
+    Ok(SegmentedCollection {
+        graph,
+        segmentation,
+        times,
+        adaptive: Some(tree),
+        start: 0,
+        start_scores: vec![score],
+        up,
+        mirror_columns,
         warnings,
         features,
         part_count,
