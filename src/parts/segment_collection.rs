@@ -658,14 +658,15 @@ struct Prepared<'a> {
     shared: Option<&'a [HeatSmoother]>,
     made: Option<Vec<HeatSmoother>>,
     cues: Option<Vec<super::PartCues>>,
-    geometry: Option<(usize, Result<usize, usize>, f64)>,
+    geometry: Option<GeometryMode>,
 }
+
+/// Parts from geometry: `(leaves, Ok(parts) or Err(upper bound on the chosen number), band)`.
+type GeometryMode = (usize, Result<usize, usize>, f64);
 
 /// With parts from geometry: `(leaves, Ok(parts) or Err(upper bound on the chosen number),
 /// band)`, the options checked; `None` in the other modes.
-fn geometry_mode(
-    options: &SegmentCollectionOptions,
-) -> Result<Option<(usize, Result<usize, usize>, f64)>, GraphError> {
+fn geometry_mode(options: &SegmentCollectionOptions) -> Result<Option<GeometryMode>, GraphError> {
     match (&options.parts, options.parts_from) {
         (None, PartsFrom::Geometry { .. }) => Err(GraphError::BadOption(
             "parts from geometry need a number of parts (--parts N)".into(),
