@@ -285,6 +285,14 @@ fn parts_from_geometry_is_recorded_and_checked() {
     let mut bytes = good.clone();
     bytes[100] ^= 1;
     std::fs::write(&cues[0], &bytes).unwrap();
+    // Without its part tree: a rerun with the tree only re-cuts it and reads no cue.
+    let trees: Vec<PathBuf> = std::fs::read_dir(out.join(".cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|x| x == "coseg-tree"))
+        .collect();
+    assert_eq!(trees.len(), 1);
+    std::fs::remove_file(&trees[0]).unwrap();
     let (run, _) = run_with(
         "t",
         &["--parts", "2", "--parts-from", "geometry", "--regions", "5"],
