@@ -194,10 +194,21 @@ pub fn fuse_routes_with(
     };
     // One source, a pair that may fail together: the shapes where one of the pair collapsed
     // with its partner, re-weighted from the collection's levels (`pair_collapse`).
-    let collapses: Vec<Option<Vec<f64>>> = match held_out {
+    let mut collapses: Vec<Option<Vec<f64>>> = match held_out {
         None => collapse_weights(routes, areas, &shapes, &matrices, pair_in),
         Some(_) => vec![None; n],
     };
+    // One source: the shapes where a route whose own residual says its correspondence failed
+    // shares the failure of the route that breaks the one-coin bound (`residual_collapse_weights`);
+    // this reading comes first, the pair's is the fallback.
+    if held_out.is_none() {
+        let read = residual_collapse_weights(routes, areas, &shapes, &matrices, pair_in);
+        for (c, r) in collapses.iter_mut().zip(read) {
+            if r.is_some() {
+                *c = r;
+            }
+        }
+    }
     for (i, &a) in areas.iter().enumerate() {
         let Some((voting, labels, kappas)) = shapes[i].take() else {
             continue;
@@ -790,6 +801,132 @@ fn collapse_weights(
         let mut w = vec![0.0; voting.len()];
         w[x] = log_odds((kxz * lx / lz).sqrt(), *classes);
         w[z] = log_odds((kxz * lz / lx).sqrt(), *classes);
+        out[i] = Some(w);
+    }
+    out
+}
+
+/// The voting position that breaks the one-coin model's bound on a shape with the pairwise κ
+/// `kappa` (three routes): the route `x` that agrees with both others more than they agree
+/// with each other allows, `κ_xy κ_xz > κ_yz` (its accuracy read off the triangle would
+/// exceed 1); `None` where the three are consistent with independent failures. At most one
+/// route can break it while every κ is at most 1.
+fn bound_breaker(kappa: &[Vec<f64>]) -> Option<usize> {
+    if kappa.len() != 3 {
+        return None;
+    }
+    (0..3).find(|&x| {
+        let (y, z) = ((x + 1) % 3, (x + 2) % 3);
+        kappa[x][y] > 0.0 && kappa[x][z] > 0.0 && kappa[x][y] * kappa[x][z] > kappa[y][z].max(0.0)
+    })
+}
+
+/// Per shape, the vote weights (voting positions) where a route's own residual says that it
+/// is the one that failed with the route breaking the one-coin bound; `None` elsewhere.
+///
+/// Where a route `x` breaks the bound ([`bound_breaker`]), the other two disagree with each
+/// other more than independent failures allow: one of them, `z`, failed *with* `x` (their
+/// joint errors read as agreement), and the agreement statistics of the shape cannot say
+/// which (the patterns are symmetric in `y` and `z`). That was read as the affinity being
+/// right on generated chairs from one source (the affinity 37.7 %, the parts 89.3 %, a rigid
+/// alignment right on 19.4 % agreeing with the affinity on a wrong label over a third of the
+/// chair: fused 37.7 %). Evidence from outside the agreements separates them where a route
+/// measures its own correspondence: the rigid route's registration residual. A residual above
+/// every residual the route has on the shapes where the three routes are consistent (no route
+/// breaks the bound) says its correspondence failed there: `z` is that route, it gets no
+/// vote, and `x` and `y` share the product `κ_xy = κ_x κ_y` by the ratio of their levels over
+/// the collection (`ℓ`, the median of their κ on the consistent shapes — the triangles, or
+/// the shared-failure fit where the fusion models a pair), `κ_x = √(κ_xy ℓ_x / ℓ_y)`, each
+/// weighted by its log-odds. No threshold: the residual is compared with the collection's
+/// own; without a consistent shape to compare with, or where no route or both report a
+/// residual above it, nothing changes.
+fn residual_collapse_weights(
+    routes: &[&RouteLabels],
+    areas: &[&[f64]],
+    shapes: &[Option<ShapeVotes>],
+    matrices: &[Vec<Vec<f64>>],
+    pair_in: impl Fn(&[usize]) -> Option<(usize, usize)>,
+) -> Vec<Option<Vec<f64>>> {
+    let n = shapes.len();
+    let mut out = vec![None; n];
+    let residual =
+        |r: usize, i: usize| routes[r].residual.get(i).copied().filter(|x| x.is_finite());
+    // The largest residual of each route, and each route's κ, on the consistent shapes.
+    let mut reference: BTreeMap<usize, f64> = BTreeMap::new();
+    let mut levels: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
+    let mut breaking = vec![None; n];
+    for (i, s) in shapes.iter().enumerate() {
+        let Some((voting, classes, kappas)) = s else {
+            continue;
+        };
+        if voting.len() != 3 {
+            continue;
+        }
+        if let Some(x) = bound_breaker(&matrices[i]) {
+            breaking[i] = Some(x);
+            continue;
+        }
+        for &r in voting {
+            if let Some(res) = residual(r, i) {
+                let e = reference.entry(r).or_insert(res);
+                *e = e.max(res);
+            }
+        }
+        let kappa: Vec<f64> = match pair_in(voting) {
+            Some(pair) => {
+                let lab: Vec<&[i32]> = voting
+                    .iter()
+                    .map(|&r| routes[r].labels[i].as_slice())
+                    .collect();
+                let Some(fit) = shared_failure_fit(&lab, areas[i], *classes, pair) else {
+                    continue;
+                };
+                let l = (*classes).max(2) as f64;
+                fit.accuracy
+                    .iter()
+                    .map(|&a| ((a - 1.0 / l) / (1.0 - 1.0 / l)).clamp(0.0, MAX_KAPPA))
+                    .collect()
+            }
+            None => kappas.clone(),
+        };
+        for (x, &r) in voting.iter().enumerate() {
+            if let Some(&k) = kappa.get(x) {
+                levels.entry(r).or_default().push(k);
+            }
+        }
+    }
+    let level: BTreeMap<usize, f64> = levels
+        .into_iter()
+        .filter(|(_, v)| !v.is_empty())
+        .map(|(r, v)| (r, crate::parts::median(&v)))
+        .collect();
+    for (i, b) in breaking.into_iter().enumerate() {
+        let (Some(x), Some((voting, classes, _))) = (b, &shapes[i]) else {
+            continue;
+        };
+        let failed: Vec<usize> = (0..3)
+            .filter(|&z| z != x)
+            .filter(|&z| {
+                let r = voting[z];
+                residual(r, i)
+                    .zip(reference.get(&r))
+                    .is_some_and(|(res, &m)| res > m)
+            })
+            .collect();
+        let [z] = failed[..] else {
+            continue;
+        };
+        let y = 3 - x - z;
+        let (Some(&lx), Some(&ly)) = (level.get(&voting[x]), level.get(&voting[y])) else {
+            continue;
+        };
+        if !(lx > 0.0 && ly > 0.0) {
+            continue;
+        }
+        let kxy = matrices[i][x][y].max(0.0);
+        let mut w = vec![0.0; 3];
+        w[x] = log_odds((kxy * lx / ly).sqrt(), *classes);
+        w[y] = log_odds((kxy * ly / lx).sqrt(), *classes);
         out[i] = Some(w);
     }
     out
