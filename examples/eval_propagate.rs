@@ -85,6 +85,10 @@ struct Set {
     route_log: Mutex<BTreeMap<String, Vec<(usize, f64)>>>,
     /// `COSEG_DUMP`: registrations `(source, target)` of every candidate pose, computed so far.
     dump_regs: Mutex<HashMap<(usize, usize), Registration>>,
+    /// The per-shape pipeline and cache the shapes were loaded with (the map route reads the
+    /// spectra from them).
+    pipeline: ShapePipelineOptions,
+    cache: PathBuf,
 }
 
 fn load(
@@ -144,6 +148,8 @@ fn load(
         parts: Mutex::new(parts),
         route_log: Mutex::new(BTreeMap::new()),
         dump_regs: Mutex::new(HashMap::new()),
+        pipeline: pipeline.clone(),
+        cache: cache.to_path_buf(),
     })
 }
 
@@ -179,6 +185,36 @@ fn run(
         eprintln!("warning: {w}");
     }
     let targets: Vec<usize> = (0..n).filter(|i| !sources.contains(i)).collect();
+    // The map route, as `propagate_loaded` runs it after the fusion.
+    if set.routes.map {
+        let fused: Vec<f64> = targets.iter().map(|&i| score(i, &p.labels[i])).collect();
+        let (maps, warnings) = coseg::propagate::map_route(
+            &set.meshes,
+            &set.graph,
+            &ann,
+            &mut p,
+            &report,
+            &set.pipeline,
+            &set.cache,
+        );
+        for w in &warnings {
+            eprintln!("warning: {w}");
+        }
+        if std::env::var_os("COSEG_DIAG").is_some() {
+            for (&i, f) in targets.iter().zip(&fused) {
+                if let Some(m) = &maps[i] {
+                    eprintln!(
+                        "diag {:>12} map route: fused {:.1} -> {:.1} (agreement {:.1} %, {})",
+                        set.names[i],
+                        100.0 * f,
+                        100.0 * score(i, &p.labels[i]),
+                        100.0 * m.agreement,
+                        if m.applied { "taken" } else { "not taken" }
+                    );
+                }
+            }
+        }
+    }
     if std::env::var_os("COSEG_DIAG").is_some() {
         if let Some(h) = &report.held_out {
             eprintln!("diag held-out {:?}", h);

@@ -241,6 +241,7 @@ fn propagate_shapes(
         outcomes: Vec::new(),
         map_steps: vec![None; n],
         map_step: None,
+        map_routes: solved.map_route,
         fusion: solved.fusion,
         warnings,
     };

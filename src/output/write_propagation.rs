@@ -44,6 +44,11 @@ pub struct PropagatedShape {
     /// The name of the source the map step mapped this shape to.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub map_source: Option<String>,
+    /// What the map route of the fusion did (a point map to `source`, its agreement with the
+    /// fused labels, and whether the shape took the vote with the map:
+    /// [`crate::propagate::map_route`]); absent where the route did not run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub map_route: Option<MapStepReport>,
 }
 
 /// `summary.json` of `coseg propagate`: no timings, so reruns give the same bytes.
@@ -107,6 +112,7 @@ impl PropagationSummary {
                         .get(i)
                         .and_then(|r| r.as_ref())
                         .map(|r| c.graph.node(r.source).name.clone()),
+                    map_route: c.map_routes.get(i).cloned().flatten(),
                 }
             })
             .collect();

@@ -77,6 +77,9 @@ pub struct PropagatedCollection {
     /// What the map step did on each shape (graph order; `None` for the sources, for shapes it
     /// could not run on, and everywhere when it is off).
     pub map_steps: Vec<Option<MapStepReport>>,
+    /// Per shape, what the map route of the fusion did ([`super::map_route`]; `None` for the
+    /// sources, or everywhere when the route did not run).
+    pub map_routes: Vec<Option<MapStepReport>>,
     /// The map step's options when it ran.
     pub map_step: Option<MapStepOptions>,
     /// Each route's labels and trust ([`fuse_propagation`]).
@@ -201,6 +204,7 @@ pub fn propagate_collection(
         outcomes: loaded.outcomes,
         map_steps,
         map_step: options.map_step.clone(),
+        map_routes: solved.map_route,
         fusion: solved.fusion,
         warnings,
     })
@@ -337,6 +341,9 @@ pub struct PropagatedShapes {
     /// off), kept so that a caller fusing again after [`Propagation::update`] does not make
     /// them again.
     pub parts: Option<CollectionParts>,
+    /// Per shape, what the map route did ([`super::map_route`]; `None` for the sources, or
+    /// everywhere when the route did not run).
+    pub map_route: Vec<Option<MapStepReport>>,
     /// Warnings for the user (smoothing turned off, a route left out).
     pub warnings: Vec<String>,
 }
@@ -413,12 +420,30 @@ pub fn propagate_loaded(
         &options.routes,
     )?;
     warnings.extend(fusion.warnings.iter().cloned());
+    let map_route = match (&options.cache_dir, options.routes.map) {
+        (Some(cache), true) => {
+            let _t = crate::stage_timer::stage("map route");
+            let (reports, w) = super::map_route(
+                meshes,
+                &graph,
+                annotations,
+                &mut propagation,
+                &fusion,
+                &options.pipeline,
+                cache,
+            );
+            warnings.extend(w);
+            reports
+        }
+        _ => vec![None; meshes.len()],
+    };
     Ok(PropagatedShapes {
         graph,
         smoothers,
         propagation,
         fusion,
         parts,
+        map_route,
         warnings,
     })
 }

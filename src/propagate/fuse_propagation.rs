@@ -44,6 +44,12 @@ pub struct RouteOptions {
     /// Whether the rigid route relaxes its similarity to an affine map before reading the
     /// labels ([`super::refine_affine`]). Default `true`.
     pub affine: bool,
+    /// The map route ([`super::map_route`]): every unlabelled shape re-labelled through a
+    /// point map to its nearest source, taken on the shapes where the routes' agreement ranks
+    /// the map as the most accurate route (near-isometric collections). Needs the shapes'
+    /// spectra from the per-shape cache (`cache_dir`); without one it does not run. Default
+    /// `true`.
+    pub map: bool,
 }
 
 impl Default for RouteOptions {
@@ -53,6 +59,7 @@ impl Default for RouteOptions {
             rigid: true,
             snap_band: 0.0,
             affine: true,
+            map: true,
         }
     }
 }
@@ -66,6 +73,7 @@ impl RouteOptions {
             rigid: false,
             snap_band: 0.0,
             affine: true,
+            map: false,
         }
     }
 

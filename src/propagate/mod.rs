@@ -24,6 +24,7 @@ mod collection;
 mod fuse_propagation;
 mod fuse_routes;
 mod held_out;
+mod map_route;
 mod map_step;
 mod options;
 mod part_scores;
@@ -40,6 +41,7 @@ pub use collection::{
 pub use fuse_propagation::{CollectionParts, FusionReport, RouteOptions, fuse_propagation};
 pub use fuse_routes::{FusedRoutes, Route, RouteLabels, fuse_routes, fuse_routes_with};
 pub use held_out::{HeldOutInputs, HeldOutRoutes, held_out_accuracy, held_out_routes};
+pub use map_route::{fuse_with_map, map_route};
 pub use map_step::{MapStepOptions, MapStepReport, map_step};
 pub use options::PropagateOptions;
 pub use part_scores::PartScore;
