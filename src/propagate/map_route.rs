@@ -1,7 +1,7 @@
 //! [`map_route`]: point maps as a fourth route of the fused propagation, taken where the
 //! routes' own agreement says they are the most accurate.
 
-use super::collection::map_step_collection;
+use super::map_step_collection::map_step_collection;
 use super::{FusionReport, MapStepOptions, MapStepReport, Propagation, RouteLabels, fuse_routes};
 use crate::graph::ShapeGraph;
 use crate::mesh::TriMesh;

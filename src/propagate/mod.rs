@@ -26,6 +26,7 @@ mod fuse_routes;
 mod held_out;
 mod map_route;
 mod map_step;
+mod map_step_collection;
 mod options;
 mod part_scores;
 mod parts_route;
@@ -36,13 +37,14 @@ mod solve;
 
 pub use collection::{
     PropagateCollectionOptions, PropagatedCollection, PropagatedShapes, SourceFile,
-    map_step_collection, propagate_collection, propagate_loaded,
+    propagate_collection, propagate_loaded,
 };
 pub use fuse_propagation::{CollectionParts, FusionReport, RouteOptions, fuse_propagation};
 pub use fuse_routes::{FusedRoutes, Route, RouteLabels, fuse_routes, fuse_routes_with};
 pub use held_out::{HeldOutInputs, HeldOutRoutes, held_out_accuracy, held_out_routes};
 pub use map_route::{fuse_with_map, map_route};
 pub use map_step::{MapStepOptions, MapStepReport, map_step};
+pub use map_step_collection::map_step_collection;
 pub use options::PropagateOptions;
 pub use part_scores::PartScore;
 pub use parts_route::parts_route;

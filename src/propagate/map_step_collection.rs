@@ -1,0 +1,125 @@
+//! [`map_step_collection`]: the map step of every unlabelled shape of a propagated collection.
+
+use super::{MapStepOptions, MapStepReport, Propagation, map_step};
+use crate::graph::ShapeGraph;
+use crate::maps::MapShape;
+use crate::mesh::TriMesh;
+use crate::pipeline::ShapePipelineOptions;
+use rayon::prelude::*;
+use std::path::Path;
+
+/// One shape's map step: its labels and report, or why it could not run.
+type MapStepOutcome = Result<(Vec<i32>, MapStepReport), String>;
+
+/// The map step ([`map_step`]) of [`propagate_collection`] on every unlabelled shape of
+/// `propagation`, each mapped to its nearest source (smallest graph summary distance; ties:
+/// the first), in parallel (one target's full per-shape data in memory per thread, the
+/// sources' shared). The shapes' spectra come from `cache` under `pipeline`
+/// ([`crate::pipeline::load_or_compute`]), so `pipeline` must be the one the graph was built
+/// with. A shape whose data or map fails keeps its propagated labels with a warning: the step
+/// is optional. A kept map replaces the shape's labels and its part shares and confidences are
+/// recomputed from them (per-vertex confidences stay the propagation's margins).
+///
+/// Inputs: `meshes` and `annotations` (`#shapes`, graph order; `Some` per-vertex labels on the
+/// sources), the `graph` and `propagation` they were solved on. Output: per shape the report
+/// (`None` for sources and skipped shapes) and warnings for the user.
+///
+/// ```no_run
+/// use coseg::propagate::{map_step_collection, propagate_collection, MapStepOptions,
+///     PropagateCollectionOptions};
+/// use std::path::{Path, PathBuf};
+/// let options = PropagateCollectionOptions::default();
+/// let mut out = propagate_collection(Path::new("poses"), &[PathBuf::from("poses/a.labels.txt")],
+///     &options).unwrap();
+/// let mut annotations = vec![None; out.meshes.len()];
+/// annotations[out.sources[0].shape] = Some(out.propagation.labels[out.sources[0].shape].clone());
+/// let cache = std::env::temp_dir().join("coseg-cache");
+/// let (reports, warnings) = map_step_collection(&out.meshes, &out.graph, &annotations,
+///     &mut out.propagation, &options.pipeline, &cache, &MapStepOptions::default());
+/// ```
+pub fn map_step_collection(
+    meshes: &[TriMesh],
+    graph: &ShapeGraph,
+    annotations: &[Option<Vec<i32>>],
+    propagation: &mut Propagation,
+    pipeline: &ShapePipelineOptions,
+    cache: &Path,
+    options: &MapStepOptions,
+) -> (Vec<Option<MapStepReport>>, Vec<String>) {
+    let n = meshes.len();
+    let name = |i: usize| graph.node(i).name.clone();
+    let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
+    let source_data: Vec<_> = sources
+        .par_iter()
+        .map(|&s| crate::pipeline::load_or_compute(&meshes[s], pipeline, cache))
+        .collect();
+    let mut warnings = Vec::new();
+    let mut loaded = Vec::with_capacity(sources.len());
+    for (&s, d) in sources.iter().zip(source_data) {
+        match d {
+            Ok(d) => loaded.push(d.data),
+            Err(e) => {
+                warnings.push(format!("map step off: source {}: {e}", name(s)));
+                return (vec![None; n], warnings);
+            }
+        }
+    }
+    let results: Vec<Option<MapStepOutcome>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if annotations[i].is_some() {
+                return None;
+            }
+            // The nearest source by summary distance (ties: the first).
+            let k = (0..sources.len())
+                .min_by(|&a, &b| {
+                    graph
+                        .summary_distance(i, sources[a])
+                        .total_cmp(&graph.summary_distance(i, sources[b]))
+                })
+                .expect("at least one source");
+            let s = sources[k];
+            let run = || -> MapStepOutcome {
+                let data = crate::pipeline::load_or_compute(&meshes[i], pipeline, cache)
+                    .map_err(|e| e.to_string())?
+                    .data;
+                let source = MapShape {
+                    spectrum: &loaded[k].spectrum,
+                    positions: meshes[s].positions(),
+                    labels: annotations[s].as_deref().unwrap_or_default(),
+                    descriptors: None,
+                };
+                let target = MapShape {
+                    spectrum: &data.spectrum,
+                    positions: meshes[i].positions(),
+                    labels: &propagation.labels[i],
+                    descriptors: None,
+                };
+                map_step(&source, &target, &graph.node(i).areas, s, options)
+                    .map_err(|e| e.to_string())
+            };
+            Some(run())
+        })
+        .collect();
+    let mut reports = vec![None; n];
+    for (i, r) in results.into_iter().enumerate() {
+        match r {
+            None => {}
+            Some(Err(e)) => warnings.push(format!("shape {}: map step skipped: {e}", name(i))),
+            Some(Ok((labels, report))) => {
+                if report.applied {
+                    propagation.set_labels(graph, i, labels);
+                } else {
+                    warnings.push(format!(
+                        "shape {}: map step rejected (its labels agree with the propagation on {:.1} % of the area, below {:.1} %)",
+                        name(i),
+                        100.0 * report.agreement,
+                        100.0 * options.min_agreement
+                    ));
+                }
+                reports[i] = Some(report);
+            }
+        }
+    }
+    (reports, warnings)
+}
