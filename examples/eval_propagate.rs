@@ -195,7 +195,7 @@ fn run(
             &mut p,
             &report,
             &set.pipeline,
-            &set.cache,
+            Some(&set.cache),
         );
         for w in &warnings {
             eprintln!("warning: {w}");

@@ -78,18 +78,7 @@ fn the_map_is_taken_only_where_the_routes_agreement_ranks_it_first() {
 fn the_map_route_runs_by_default_and_reports_each_copy() {
     use common::features::labelled_blob_and_copies;
     let dir = tempfile::tempdir().unwrap();
-    let slab = |x: f64| {
-        if x < -0.4 {
-            0
-        } else if x < 0.35 {
-            1
-        } else {
-            2
-        }
-    };
-    let truth_of = |m: &coseg::mesh::TriMesh| -> Vec<i32> {
-        m.positions().iter().map(|p| slab(p[0])).collect()
-    };
+    let truth_of = common::features::three_slabs;
     let (shapes, _, copies) = labelled_blob_and_copies(dir.path(), truth_of);
     let mut o = PropagateCollectionOptions::default();
     o.pipeline.spectrum.eigenpairs = 40;

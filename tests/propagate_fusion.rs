@@ -192,18 +192,7 @@ fn identical_copies_keep_the_sources_labels_under_the_default_fusion() {
     use coseg::evaluate::vertex_label_agreement;
     use coseg::propagate::{PropagateCollectionOptions, RouteOptions, propagate_collection};
     let dir = tempfile::tempdir().unwrap();
-    let slab = |x: f64| {
-        if x < -0.4 {
-            0
-        } else if x < 0.35 {
-            1
-        } else {
-            2
-        }
-    };
-    let truth_of = |m: &coseg::mesh::TriMesh| -> Vec<i32> {
-        m.positions().iter().map(|p| slab(p[0])).collect()
-    };
+    let truth_of = common::features::three_slabs;
     let (shapes, _, copies) = labelled_blob_and_copies(dir.path(), truth_of);
     for (what, routes) in [
         ("default", RouteOptions::default()),

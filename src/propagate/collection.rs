@@ -304,8 +304,8 @@ pub fn propagate_loaded(
         &options.routes,
     )?;
     warnings.extend(fusion.warnings.iter().cloned());
-    let map_route = match (&options.cache_dir, options.routes.map) {
-        (Some(cache), true) => {
+    let map_route = match options.routes.map {
+        true => {
             let _t = crate::stage_timer::stage("map route");
             let (reports, w) = super::map_route(
                 meshes,
@@ -314,12 +314,12 @@ pub fn propagate_loaded(
                 &mut propagation,
                 &fusion,
                 &options.pipeline,
-                cache,
+                options.cache_dir.as_deref(),
             );
             warnings.extend(w);
             reports
         }
-        _ => vec![None; meshes.len()],
+        false => vec![None; meshes.len()],
     };
     Ok(PropagatedShapes {
         graph,

@@ -46,9 +46,9 @@ pub struct RouteOptions {
     pub affine: bool,
     /// The map route ([`super::map_route`]): every unlabelled shape re-labelled through a
     /// point map to its nearest source, taken on the shapes where the routes' agreement ranks
-    /// the map as the most accurate route (near-isometric collections). Needs the shapes'
-    /// spectra from the per-shape cache (`cache_dir`); without one it does not run. Default
-    /// `true`.
+    /// the map as the most accurate route (near-isometric collections). Reads the shapes'
+    /// spectra from the per-shape cache (`cache_dir`), or computes them in memory without one.
+    /// Default `true`.
     pub map: bool,
 }
 

@@ -771,11 +771,7 @@ fn collapse_weights(
             }
         }
     }
-    let level: BTreeMap<usize, f64> = levels
-        .into_iter()
-        .filter(|(_, v)| !v.is_empty())
-        .map(|(r, v)| (r, crate::parts::median(&v)))
-        .collect();
+    let level = route_levels(levels);
     for (i, c) in collapsed.into_iter().enumerate() {
         let (Some((y, x, z)), Some((voting, classes, _))) = (c, &shapes[i]) else {
             continue;
@@ -895,11 +891,7 @@ fn residual_collapse_weights(
             }
         }
     }
-    let level: BTreeMap<usize, f64> = levels
-        .into_iter()
-        .filter(|(_, v)| !v.is_empty())
-        .map(|(r, v)| (r, crate::parts::median(&v)))
-        .collect();
+    let level = route_levels(levels);
     for (i, b) in breaking.into_iter().enumerate() {
         let (Some(x), Some((voting, classes, _))) = (b, &shapes[i]) else {
             continue;
@@ -930,4 +922,14 @@ fn residual_collapse_weights(
         out[i] = Some(w);
     }
     out
+}
+
+/// Each route's level over the collection: the median of the accuracies above chance it was
+/// read at on the shapes that give one (routes with none are left out).
+fn route_levels(levels: BTreeMap<usize, Vec<f64>>) -> BTreeMap<usize, f64> {
+    levels
+        .into_iter()
+        .filter(|(_, v)| !v.is_empty())
+        .map(|(r, v)| (r, crate::parts::median(&v)))
+        .collect()
 }

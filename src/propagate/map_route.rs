@@ -1,7 +1,7 @@
 //! [`map_route`]: point maps as a fourth route of the fused propagation, taken where the
 //! routes' own agreement says they are the most accurate.
 
-use super::map_step_collection::map_step_collection;
+use super::map_step_collection::map_step_collection_with;
 use super::{FusionReport, MapStepOptions, MapStepReport, Propagation, RouteLabels, fuse_routes};
 use crate::graph::ShapeGraph;
 use crate::mesh::TriMesh;
@@ -29,7 +29,8 @@ use std::path::Path;
 ///
 /// Inputs: `meshes`, `graph`, `annotations` and the fused `propagation` as
 /// [`super::fuse_propagation`] left them, its `fusion` report (the routes' labels),
-/// `pipeline` and `cache` (the shapes' spectra, as [`map_step_collection`] reads them).
+/// `pipeline` and `cache` (the shapes' spectra, as [`super::map_step_collection`] reads them;
+/// `None`: computed in memory, the same numbers).
 /// Output: per shape (`None` for sources and shapes without a map) the map's source, its
 /// agreement with the fused labels and whether the shape took the vote with the map; and
 /// warnings. A shape whose map fails keeps the fused labels (the route is optional).
@@ -47,7 +48,7 @@ pub fn map_route(
     propagation: &mut Propagation,
     fusion: &FusionReport,
     pipeline: &ShapePipelineOptions,
-    cache: &Path,
+    cache: Option<&Path>,
 ) -> (Vec<Option<MapStepReport>>, Vec<String>) {
     let n = meshes.len();
     // The triangles need two other routes to rank the map against.
@@ -59,7 +60,7 @@ pub fn map_route(
         min_agreement: 0.0,
         ..MapStepOptions::default()
     };
-    let (reports, warnings) = map_step_collection(
+    let (reports, warnings) = map_step_collection_with(
         meshes,
         graph,
         annotations,

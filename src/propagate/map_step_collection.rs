@@ -46,18 +46,45 @@ pub fn map_step_collection(
     cache: &Path,
     options: &MapStepOptions,
 ) -> (Vec<Option<MapStepReport>>, Vec<String>) {
+    map_step_collection_with(
+        meshes,
+        graph,
+        annotations,
+        propagation,
+        pipeline,
+        Some(cache),
+        options,
+    )
+}
+
+/// [`map_step_collection`] with the cache optional: without one, each shape's spectrum is
+/// computed in memory ([`crate::pipeline::compute_shape_data`], the same numbers a cache
+/// entry holds), so shapes given as arrays get the same maps as their files.
+pub(crate) fn map_step_collection_with(
+    meshes: &[TriMesh],
+    graph: &ShapeGraph,
+    annotations: &[Option<Vec<i32>>],
+    propagation: &mut Propagation,
+    pipeline: &ShapePipelineOptions,
+    cache: Option<&Path>,
+    options: &MapStepOptions,
+) -> (Vec<Option<MapStepReport>>, Vec<String>) {
+    let shape_data = |m: &TriMesh| match cache {
+        Some(c) => crate::pipeline::load_or_compute(m, pipeline, c).map(|r| r.data),
+        None => crate::pipeline::compute_shape_data(m, pipeline),
+    };
     let n = meshes.len();
     let name = |i: usize| graph.node(i).name.clone();
     let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
     let source_data: Vec<_> = sources
         .par_iter()
-        .map(|&s| crate::pipeline::load_or_compute(&meshes[s], pipeline, cache))
+        .map(|&s| shape_data(&meshes[s]))
         .collect();
     let mut warnings = Vec::new();
     let mut loaded = Vec::with_capacity(sources.len());
     for (&s, d) in sources.iter().zip(source_data) {
         match d {
-            Ok(d) => loaded.push(d.data),
+            Ok(d) => loaded.push(d),
             Err(e) => {
                 warnings.push(format!("map step off: source {}: {e}", name(s)));
                 return (vec![None; n], warnings);
@@ -80,9 +107,7 @@ pub fn map_step_collection(
                 .expect("at least one source");
             let s = sources[k];
             let run = || -> MapStepOutcome {
-                let data = crate::pipeline::load_or_compute(&meshes[i], pipeline, cache)
-                    .map_err(|e| e.to_string())?
-                    .data;
+                let data = shape_data(&meshes[i]).map_err(|e| e.to_string())?;
                 let source = MapShape {
                     spectrum: &loaded[k].spectrum,
                     positions: meshes[s].positions(),

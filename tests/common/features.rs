@@ -143,3 +143,20 @@ pub fn labelled_blob_and_copies(
     }
     (shapes, mesh, copies)
 }
+
+/// Three parts of a mesh cut by planes across `x` (at −0.4 and 0.35): labels 0, 1, 2 per vertex,
+/// the blob's slab parts of the propagation tests.
+pub fn three_slabs(mesh: &TriMesh) -> Vec<i32> {
+    mesh.positions()
+        .iter()
+        .map(|p| {
+            if p[0] < -0.4 {
+                0
+            } else if p[0] < 0.35 {
+                1
+            } else {
+                2
+            }
+        })
+        .collect()
+}
