@@ -50,6 +50,34 @@ pub fn map_route(
     pipeline: &ShapePipelineOptions,
     cache: Option<&Path>,
 ) -> (Vec<Option<MapStepReport>>, Vec<String>) {
+    let all = vec![true; meshes.len()];
+    map_route_on(
+        meshes,
+        graph,
+        annotations,
+        propagation,
+        fusion,
+        pipeline,
+        cache,
+        &all,
+    )
+}
+
+/// [`map_route`] on the shapes flagged in `targets` only (one flag per shape); the others
+/// get no map and keep the fusion's labels. For an incremental session (the labelling
+/// studio): after an update, a map is fitted again only where the last run took it, since a
+/// map costs a ZoomOut per shape while the fusion's vote is one pass.
+#[allow(clippy::too_many_arguments)]
+pub fn map_route_on(
+    meshes: &[TriMesh],
+    graph: &ShapeGraph,
+    annotations: &[Option<Vec<i32>>],
+    propagation: &mut Propagation,
+    fusion: &FusionReport,
+    pipeline: &ShapePipelineOptions,
+    cache: Option<&Path>,
+    targets: &[bool],
+) -> (Vec<Option<MapStepReport>>, Vec<String>) {
     let n = meshes.len();
     // The triangles need two other routes to rank the map against.
     if fusion.routes.len() < 2 || annotations.iter().all(Option::is_none) {
@@ -68,6 +96,7 @@ pub fn map_route(
         pipeline,
         cache,
         &ungated,
+        Some(targets),
     );
     let has = |i: usize| reports[i].is_some();
     let route = RouteLabels {

@@ -54,12 +54,15 @@ pub fn map_step_collection(
         pipeline,
         Some(cache),
         options,
+        None,
     )
 }
 
 /// [`map_step_collection`] with the cache optional: without one, each shape's spectrum is
 /// computed in memory ([`crate::pipeline::compute_shape_data`], the same numbers a cache
-/// entry holds), so shapes given as arrays get the same maps as their files.
+/// entry holds), so shapes given as arrays get the same maps as their files; and with
+/// `targets` (one flag per shape) only the flagged unlabelled shapes are mapped.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn map_step_collection_with(
     meshes: &[TriMesh],
     graph: &ShapeGraph,
@@ -68,7 +71,12 @@ pub(crate) fn map_step_collection_with(
     pipeline: &ShapePipelineOptions,
     cache: Option<&Path>,
     options: &MapStepOptions,
+    targets: Option<&[bool]>,
 ) -> (Vec<Option<MapStepReport>>, Vec<String>) {
+    let wanted = |i: usize| annotations[i].is_none() && targets.is_none_or(|t| t[i]);
+    if !(0..meshes.len()).any(wanted) {
+        return (vec![None; meshes.len()], Vec::new());
+    }
     let shape_data = |m: &TriMesh| match cache {
         Some(c) => crate::pipeline::load_or_compute(m, pipeline, c).map(|r| r.data),
         None => crate::pipeline::compute_shape_data(m, pipeline),
@@ -94,7 +102,7 @@ pub(crate) fn map_step_collection_with(
     let results: Vec<Option<MapStepOutcome>> = (0..n)
         .into_par_iter()
         .map(|i| {
-            if annotations[i].is_some() {
+            if !wanted(i) {
                 return None;
             }
             // The nearest source by summary distance (ties: the first).

@@ -5,8 +5,8 @@ use crate::graph::{ShapeGraph, ShapeNode, load_collection};
 use crate::labels::{read_part_names, read_shape_labels, vertices_to_faces};
 use crate::mesh::{TriMesh, write_atomic};
 use crate::propagate::{
-    CollectionParts, PropagateCollectionOptions, Propagation, fuse_propagation, propagate_labels,
-    propagate_loaded,
+    CollectionParts, MapStepReport, PropagateCollectionOptions, Propagation, fuse_propagation,
+    map_route_on, propagate_labels, propagate_loaded,
 };
 use crate::render::{RgbImage, ViewFrame, canonical_frame, draw_mesh, encode_png};
 use crate::spectral::HeatSmoother;
@@ -107,6 +107,9 @@ struct Solved {
     /// The parts route's co-segmentations ([`crate::propagate::PropagatedShapes::parts`]), reused by each
     /// fusion after an update.
     parts: Option<CollectionParts>,
+    /// Per shape, what the map route did in the last run ([`map_route_on`]): after an
+    /// update, a map is fitted again only where it was taken.
+    map_route: Vec<Option<MapStepReport>>,
 }
 
 /// `summary.json` of a saved session.
@@ -196,10 +199,15 @@ impl Studio {
             .into_iter()
             .unzip();
         let n = names.len();
+        // The propagation reads the same cache the collection was loaded through: the map
+        // route re-reads each shape's spectrum from it instead of recomputing it in memory on
+        // every propagation.
+        let mut propagate_options = options.propagate.clone();
+        propagate_options.cache_dir = Some(cache);
         let mut studio = Studio {
             folder,
             labels_dir,
-            options: options.propagate.clone(),
+            options: propagate_options,
             names,
             frames,
             patches,
@@ -603,7 +611,7 @@ impl Studio {
                     total: changed.len(),
                 });
             }
-            report.warnings = self.fuse_routes()?;
+            report.warnings = self.fuse_routes(false)?;
         } else {
             report.full = true;
             match self.solved.as_mut() {
@@ -618,7 +626,7 @@ impl Studio {
                         &self.options.propagate,
                     )?;
                     s.propagation.rigid = rigid;
-                    report.warnings = self.fuse_routes()?;
+                    report.warnings = self.fuse_routes(true)?;
                 }
                 None => {
                     let nodes = self.nodes.clone().expect("nodes kept until the first run");
@@ -631,6 +639,7 @@ impl Studio {
                         smoothers: out.smoothers,
                         propagation: out.propagation,
                         parts: out.parts,
+                        map_route: out.map_route,
                     });
                 }
             }
@@ -655,10 +664,13 @@ impl Studio {
     }
 
     /// Fuses the band-affinity labels of the last update or solve with the other routes, as
-    /// [`propagate_loaded`] does after its solve ([`fuse_propagation`]), so that a session's
-    /// labels after an update are those `coseg propagate` gives (the update itself moves the
-    /// band affinity alone). Returns the routes' warnings.
-    fn fuse_routes(&mut self) -> Result<Vec<String>, StudioError> {
+    /// [`propagate_loaded`] does after its solve ([`fuse_propagation`], then the map route
+    /// when `routes.map` is on), so that a session's labels after an update are those
+    /// `coseg propagate` gives (the update itself moves the band affinity alone). The map
+    /// route runs on every shape after a `full` solve, and after an update only where the
+    /// last run took it ([`map_route_on`]: a ZoomOut map per shape costs more than the rest
+    /// of an update). Returns the routes' warnings.
+    fn fuse_routes(&mut self, full: bool) -> Result<Vec<String>, StudioError> {
         let Some(s) = self.solved.as_mut() else {
             return Ok(Vec::new());
         };
@@ -672,7 +684,29 @@ impl Studio {
             &self.options.propagate,
             &self.options.routes,
         )?;
-        Ok(fusion.warnings)
+        let mut warnings = fusion.warnings.clone();
+        if self.options.routes.map {
+            let targets: Vec<bool> = (0..self.meshes.len())
+                .map(|i| full || matches!(s.map_route.get(i), Some(Some(r)) if r.applied))
+                .collect();
+            let (reports, w) = map_route_on(
+                &self.meshes,
+                &s.graph,
+                &self.annotations,
+                &mut s.propagation,
+                &fusion,
+                &self.options.pipeline,
+                self.options.cache_dir.as_deref(),
+                &targets,
+            );
+            // A shape not mapped again keeps what it had: a map not taken stays not taken.
+            s.map_route.resize(targets.len(), None);
+            for (i, r) in reports.into_iter().enumerate().filter(|&(i, _)| targets[i]) {
+                s.map_route[i] = r;
+            }
+            warnings.extend(w);
+        }
+        Ok(warnings)
     }
 
     /// Writes the session into the labels folder (created if missing), each file atomically:
