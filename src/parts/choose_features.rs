@@ -28,9 +28,22 @@
 //! extrinsic columns regions that carry over worse on most shapes, an advantage of the
 //! spectral family larger than its spread across shapes, and the intrinsic family wins;
 //! nothing depends on how the files are oriented beyond what the alignment recovers.
+//!
+//! The probe's consistency is not correspondence: on a collection of different bodies (a
+//! stool and an armchair, generated humanoids of varied proportions) the spectral regions can
+//! carry over consistently and still mix parts, and the paired test then drops the extrinsic
+//! family that the parts need (docs/PARTS.md: every generated set where the spectral family
+//! was chosen had worse parts). So the spectral family alone needs a second, independent
+//! piece of evidence: that the collection is near-isometric, read from the shapes' spectra
+//! ([`super::spectral_agreement`]: most shapes have a spectrally nearest shape that the map
+//! step would call near-isometric). Without it both families are kept whatever the probe says;
+//! with it the paired test decides as above. The rigid alignment's residual was measured as
+//! the alternative prior and points the wrong way (posed TOSCA and FAUST bodies align with
+//! smaller residuals than the generated rigid families, docs/PARTS.md).
 
 use super::aligned_extrinsic_bands::{aligned_extrinsic_bands, concat_tables};
 use super::paired_advantage::{PairedAdvantage, paired_advantage};
+use super::spectral_agreement::{SpectralAgreement, spectral_agreement};
 use super::start_score::start_score;
 use crate::align::{AlignError, AlignOptions, CollectionAlignment, FrameCase, align_collection};
 use crate::bands::BandWeighting;
@@ -69,6 +82,10 @@ pub struct ChooseFeaturesOptions {
     /// drops the extrinsic family (default 0.05: the p-value must be below it; 0 keeps both
     /// families whenever they could be computed).
     pub significance: f64,
+    /// Whether the spectral family alone also needs the collection to be near-isometric by its
+    /// spectra ([`super::spectral_agreement`]; default true). `false`: the paired test alone
+    /// decides (the rule of commit ae717a7).
+    pub require_near_isometric: bool,
 }
 
 /// Normal columns `|n · u|` of the chosen extrinsic family (a heuristic, hence private; the
@@ -102,6 +119,7 @@ impl Default for ChooseFeaturesOptions {
             weighting: BandWeighting::Count,
             probe_regions: DEFAULT_PROBE_REGIONS,
             significance: DEFAULT_SIGNIFICANCE,
+            require_near_isometric: true,
         }
     }
 }
@@ -146,6 +164,11 @@ pub struct FeatureChoice {
     /// The significance level the p-value was held against
     /// ([`ChooseFeaturesOptions::significance`]).
     pub significance: f64,
+    /// How far the shapes' spectra agree ([`super::spectral_agreement`]): the spectral family
+    /// alone is used only when they say near-isometric. `None` when it was not asked
+    /// ([`ChooseFeaturesOptions::require_near_isometric`] false) or not needed (no extrinsic
+    /// candidate).
+    pub spectral_agreement: Option<SpectralAgreement>,
     /// The probe's score with both families for each up axis tried: the positive file axis
     /// when the files' frames agree; the synchronised frame's up as the alignment found it,
     /// then reversed, when the shapes were moved.
@@ -302,6 +325,24 @@ pub(crate) fn choose_features(
         .as_ref()
         .map(|b| paired_advantage(&intrinsic_shapes, &b.4));
     let significance = options.significance;
+    // The spectra are read only when they can change the choice: with an extrinsic candidate.
+    let agreement = match &best {
+        Some(_) if options.require_near_isometric => {
+            let _t = crate::stage_timer::stage("parts: spectral agreement");
+            Some(spectral_agreement(meshes))
+        }
+        _ => None,
+    };
+    let significant = advantage.is_some_and(|a| a.p_value < significance);
+    let isometric = agreement.as_ref().is_none_or(|a| a.near_isometric);
+    let spectra = agreement.as_ref().map_or(String::new(), |a| {
+        format!(
+            "{} of {} shapes have a near-isometric partner by their spectra (nearest eigenvalue discrepancy {})",
+            a.with_partner,
+            a.shapes,
+            nearest_text(&a.nearest)
+        )
+    });
     let test = advantage.map_or(String::new(), |a| {
         format!(
             "; per shape the spectral family's advantage is {:+.3} ± {:.3} (standard error over {} shapes, one-sided paired t-test {}, level {significance})",
@@ -327,9 +368,21 @@ pub(crate) fn choose_features(
         .collect::<Vec<_>>()
         .join(" / ");
     Ok(match best {
-        Some((_, g, weights, up, _))
-            if advantage.is_some_and(|a| a.p_value.is_nan() || a.p_value >= significance) =>
-        {
+        Some((_, g, weights, up, _)) if !significant || !isometric => {
+            let reason = if isometric {
+                let prior = if spectra.is_empty() {
+                    String::new()
+                } else {
+                    format!(" ({spectra})")
+                };
+                format!(
+                    "features spectral,extrinsic: the collection is rigid-like ({case}){prior}; its regions do not carry over significantly more consistently with the spectral family alone (mean confidence {intrinsic_score:.3}) than with the extrinsic family in the collection frame added ({scores}{signs}){test}"
+                )
+            } else {
+                format!(
+                    "features spectral,extrinsic: the collection is not near-isometric ({spectra}), so the spectral family's consistency is no evidence of correspondence ({case}; probe mean confidence {intrinsic_score:.3} spectral, {scores}{signs} with the extrinsic family{test})"
+                )
+            };
             ChosenFeatures {
             graph: g,
             feature_weights: weights,
@@ -341,12 +394,11 @@ pub(crate) fn choose_features(
                 aligned_score,
                 spectral_advantage: advantage,
                 significance,
+                spectral_agreement: agreement,
                 aligned_scores,
                 frame,
                 up,
-                reason: format!(
-                    "features spectral,extrinsic: the collection is rigid-like ({case}); its regions do not carry over significantly more consistently with the spectral family alone (mean confidence {intrinsic_score:.3}) than with the extrinsic family in the collection frame added ({scores}{signs}){test}"
-                ),
+                reason,
             },
             }
         }
@@ -361,18 +413,32 @@ pub(crate) fn choose_features(
                 aligned_score,
                 spectral_advantage: advantage,
                 significance,
-                aligned_scores,
-                frame,
-                up: None,
                 reason: match aligned_score {
-                    Some(_) => format!(
+                    Some(_) if spectra.is_empty() => format!(
                         "features spectral: the collection is near-isometric or does not align rigidly ({case}); its regions carry over significantly more consistently with the spectral family alone (mean confidence {intrinsic_score:.3}) than with the extrinsic family added ({scores}{signs}){test}"
+                    ),
+                    Some(_) => format!(
+                        "features spectral: the collection is near-isometric ({spectra}; {case}); its regions carry over significantly more consistently with the spectral family alone (mean confidence {intrinsic_score:.3}) than with the extrinsic family added ({scores}{signs}){test}"
                     ),
                     None => "features spectral: the extrinsic family could not be computed (see the warning)".to_string(),
                 },
+                spectral_agreement: agreement,
+                aligned_scores,
+                frame,
+                up: None,
             },
         },
     })
+}
+
+/// The median of the shapes' nearest-partner discrepancies for the reason sentence (`none`
+/// when no shape has one).
+fn nearest_text(nearest: &[Option<f64>]) -> String {
+    let d: Vec<f64> = nearest.iter().flatten().copied().collect();
+    if d.is_empty() {
+        return "none".to_string();
+    }
+    format!("median {:.3}", super::median(&d))
 }
 
 /// A p-value for the reason sentence: three decimals, or `p < 0.001` below what they show.

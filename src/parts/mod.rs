@@ -15,6 +15,8 @@
 //! - [`geometric_part_tree`]: a part tree over equal-area regions that merges touching regions
 //!   (and mirror pairs) of one thickness, read from each shape's [`PartCues`].
 //! - [`snap_part_boundaries`]: the parts' boundaries moved onto creases.
+//! - [`spectral_agreement`]: whether a collection is near-isometric by its spectra, which the
+//!   feature choice asks before it drops the extrinsic family.
 //! - [`PartsReport`]: what `summary.json` records of a parts run.
 //! - [`part_tree`] and [`cut_part_tree`]: parts from geometry in two steps, the tree (the
 //!   costly part) and its cut; [`segment_collection_cached`] keeps the tree in the cache, so
@@ -34,6 +36,7 @@ mod part_tree_cache;
 mod parts_report;
 mod segment_collection;
 mod snap_part_boundaries;
+mod spectral_agreement;
 mod split_disconnected_leaves;
 mod start_score;
 
@@ -62,5 +65,6 @@ pub use segment_collection::{
 };
 pub(crate) use segment_collection::{GEOMETRY_LEAVES, segment_collection_sharing};
 pub use snap_part_boundaries::snap_part_boundaries;
+pub use spectral_agreement::{SpectralAgreement, spectral_agreement};
 pub use split_disconnected_leaves::{SplitLeaves, split_disconnected_leaves};
 pub use start_score::start_score;

@@ -30,6 +30,7 @@ use super::segment_collection::{
     PartTreeStage, PartsFrom, SegmentCollectionOptions, SegmentTimes, SegmentedCollection,
     cut_part_tree, part_tree, segment_collection,
 };
+use super::spectral_agreement::SpectralAgreement;
 use crate::align::FrameCase;
 use crate::bands::BandTable;
 use crate::cache::{
@@ -42,7 +43,7 @@ use serde::{Deserialize, Serialize};
 use std::path::Path;
 
 /// Version of the part-tree entry's layout ([`StoredPartTree`]); part of [`part_tree_key`].
-const PART_TREE_VERSION: u32 = 1;
+const PART_TREE_VERSION: u32 = 2;
 
 /// The cache key of a collection's part tree: BLAKE3 of the cache format, the entry's layout
 /// version, the crate version, the hash of the crate's sources at build time, then per shape
@@ -105,6 +106,7 @@ struct StoredChoice {
     /// [`PairedAdvantage`]: shapes, mean, standard error, t, p-value.
     spectral_advantage: Option<(usize, f64, f64, f64, f64)>,
     significance: f64,
+    spectral_agreement: Option<SpectralAgreement>,
     aligned_scores: Vec<f64>,
     frame: Option<FrameCase>,
     up: Option<[f64; 3]>,
@@ -121,6 +123,7 @@ impl From<&FeatureChoice> for StoredChoice {
                 .spectral_advantage
                 .map(|a| (a.shapes, a.mean, a.standard_error, a.t, a.p_value)),
             significance: c.significance,
+            spectral_agreement: c.spectral_agreement.clone(),
             aligned_scores: c.aligned_scores.clone(),
             frame: c.frame,
             up: c.up,
@@ -149,6 +152,7 @@ impl From<StoredChoice> for FeatureChoice {
                 },
             ),
             significance: c.significance,
+            spectral_agreement: c.spectral_agreement,
             aligned_scores: c.aligned_scores,
             frame: c.frame,
             up: c.up,
