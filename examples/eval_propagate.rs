@@ -18,7 +18,8 @@
 //! on stderr), `--cache DIR` (default /tmp/coseg-eval-cache), `--routes all|affinity` (the
 //! library's default fusion of every route, or the band affinity alone; with `all` each route
 //! alone is printed beside the fusion), `--snap-band B`, `--affine true|false` (the rigid
-//! route's affine relaxation), `--size-prior A`,
+//! route's affine relaxation), `--classifier true|false` (the classifier refinement; the
+//! fused labels before it are printed as "fused before classifier"), `--size-prior A`,
 //! `--network-weight W`, `--similarity-power P`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
 //! `--part-score affinity|geometric`, `--area-weighted true|false`, `--refit-rounds N`,
 //! `--refit-weight B`, `--update-relays true|false`;
@@ -291,6 +292,33 @@ fn run(
         .iter()
         .map(|&i| (i, score(i, &report.fused.labels[i])))
         .collect();
+    if let Some(c) = &report.classifier {
+        let before: Vec<(usize, f64)> = targets
+            .iter()
+            .map(|&i| (i, score(i, &c.before[i])))
+            .collect();
+        log.entry("fused before classifier".into())
+            .or_default()
+            .push((sources[0], mean(&before)));
+        if std::env::var_os("COSEG_DIAG").is_some() {
+            eprintln!(
+                "diag classifier held-out {:?} weight {:.2}",
+                c.held_out, c.weight
+            );
+            for (&i, b) in targets.iter().zip(&before) {
+                if let Some(s) = &c.shapes[i] {
+                    eprintln!(
+                        "diag {:>12} classifier: {:.1} -> {:.1} (disputed {:.1} %, changed {:.1} %)",
+                        set.names[i],
+                        100.0 * b.1,
+                        100.0 * score(i, &report.fused.labels[i]),
+                        100.0 * s.disputed,
+                        100.0 * s.changed
+                    );
+                }
+            }
+        }
+    }
     log.entry("fused, votes' boundaries".into())
         .or_default()
         .push((sources[0], mean(&fused_unsnapped)));
@@ -667,6 +695,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             }
             "--snap-band" => routes.snap_band = val()?.parse()?,
             "--affine" => routes.affine = val()?.parse()?,
+            "--classifier" => routes.classifier = val()?.parse()?,
             "--triple" => triple = Some(val()?),
             "--sources" => only = Some(val()?.split(',').map(str::to_string).collect()),
             "--features" => features = val()?,

@@ -4,7 +4,9 @@ use super::{OutputError, region_colors, write_summary};
 use crate::graph::GraphOptions;
 use crate::labels::{LabelKind, vertices_to_faces, write_face_labels, write_vertex_labels};
 use crate::mesh::{PlyVertexProperty, write_mesh};
-use crate::propagate::{MapStepOptions, MapStepReport, PropagateOptions, PropagatedCollection};
+use crate::propagate::{
+    ClassifierShape, MapStepOptions, MapStepReport, PropagateOptions, PropagatedCollection,
+};
 use serde::Serialize;
 use std::path::{Path, PathBuf};
 
@@ -49,6 +51,11 @@ pub struct PropagatedShape {
     /// [`crate::propagate::map_route`]); absent where the route did not run.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub map_route: Option<MapStepReport>,
+    /// What the classifier refinement did on the shape (the area shares where the routes
+    /// disagree and where it changed the fused label: [`crate::propagate::classifier_route`]);
+    /// absent where it did not run.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub classifier: Option<ClassifierShape>,
 }
 
 /// `summary.json` of `coseg propagate`: no timings, so reruns give the same bytes.
@@ -113,6 +120,11 @@ impl PropagationSummary {
                         .and_then(|r| r.as_ref())
                         .map(|r| c.graph.node(r.source).name.clone()),
                     map_route: c.map_routes.get(i).cloned().flatten(),
+                    classifier: c
+                        .fusion
+                        .classifier
+                        .as_ref()
+                        .and_then(|r| r.shapes.get(i).copied().flatten()),
                 }
             })
             .collect();

@@ -3,8 +3,8 @@
 use super::held_out::{HeldOutInputs, held_out_routes_cached};
 use super::rigid_route::rigid_route_weighed;
 use super::{
-    FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation, Route, RouteLabels,
-    fuse_routes_with, parts_route, snap_labels,
+    ClassifierReport, FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation,
+    Route, RouteLabels, classifier_route, fuse_routes_with, parts_route, snap_labels,
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
@@ -50,6 +50,10 @@ pub struct RouteOptions {
     /// spectra from the per-shape cache (`cache_dir`), or computes them in memory without one.
     /// Default `true`.
     pub map: bool,
+    /// The classifier ([`super::classifier_route`]): a per-vertex classifier on the band
+    /// features, trained on the sources and on the vertices where every route agrees, settles
+    /// the vertices where the routes disagree, weighted by its accuracy on the sources.
+    pub classifier: bool,
 }
 
 impl Default for RouteOptions {
@@ -60,6 +64,7 @@ impl Default for RouteOptions {
             snap_band: 0.0,
             affine: true,
             map: true,
+            classifier: true,
         }
     }
 }
@@ -74,6 +79,7 @@ impl RouteOptions {
             snap_band: 0.0,
             affine: true,
             map: false,
+            classifier: false,
         }
     }
 
@@ -312,6 +318,8 @@ pub struct FusionReport {
     /// The held-out runs themselves (each source's labels from every route); `None` with
     /// fewer than two sources.
     pub held_out_runs: Option<HeldOutRoutes>,
+    /// What the classifier did ([`super::classifier_route`]); `None` where it did not run.
+    pub classifier: Option<ClassifierReport>,
 }
 
 /// Fuses the band-affinity `propagation` with the other correspondence routes of `options`
@@ -446,6 +454,16 @@ pub fn fuse_propagation(
         .zip(names.iter().position(|&r| r == Route::Parts))
         .filter(|_| parts_intrinsic);
     report.fused = fuse_routes_with(&refs, &areas, report.held_out.as_deref(), shared);
+    if options.classifier {
+        let _t = crate::stage_timer::stage("classifier");
+        report.classifier = Some(classifier_route(
+            graph,
+            annotations,
+            &refs,
+            &mut report.fused,
+            smoothers,
+        ));
+    }
     let snapped = snap_labels(meshes, &report.fused.labels, options.snap_band)?;
     for (i, labels) in snapped.into_iter().enumerate() {
         if annotations[i].is_some() || labels.is_empty() {

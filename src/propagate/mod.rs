@@ -20,6 +20,7 @@
 //!   ([`PropagateCollectionOptions::map_step`], `coseg propagate --map-step`);
 //!   [`map_step_collection`] runs it on every unlabelled shape of a propagation.
 
+mod classifier_route;
 mod collection;
 mod fuse_propagation;
 mod fuse_routes;
@@ -35,6 +36,7 @@ mod rigid_route;
 mod snap_labels;
 mod solve;
 
+pub use classifier_route::{ClassifierReport, ClassifierShape, classifier_route};
 pub use collection::{
     PropagateCollectionOptions, PropagatedCollection, PropagatedShapes, SourceFile,
     propagate_collection, propagate_loaded,
