@@ -18,7 +18,7 @@
 //! on stderr), `--cache DIR` (default /tmp/coseg-eval-cache), `--routes all|affinity` (the
 //! library's default fusion of every route, or the band affinity alone; with `all` each route
 //! alone is printed beside the fusion), `--snap-band B`, `--affine true|false` (the rigid
-//! route's affine relaxation), `--classifier true|false` (the classifier refinement; the
+//! route's affine relaxation), `--classifier true|false` (the classifier refinement, off by default; with it on the
 //! fused labels before it are printed as "fused before classifier"), `--size-prior A`,
 //! `--network-weight W`, `--similarity-power P`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
 //! `--part-score affinity|geometric`, `--area-weighted true|false`, `--refit-rounds N`,
