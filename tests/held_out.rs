@@ -33,6 +33,7 @@ fn affinity_only<'a>(
         routes: &[Route::Affinity],
         segmentation: None,
         affine: true,
+        nonrigid: false,
     }
 }
 

@@ -493,7 +493,7 @@ fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() 
         &o.routes,
     )
     .unwrap();
-    let (fresh, _) = rigid_route(&meshes, &second, o.routes.affine);
+    let (fresh, _) = rigid_route(&meshes, &second, o.routes.rigid_steps());
     let kept = &report
         .routes
         .iter()
@@ -530,6 +530,7 @@ fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() 
         routes: &names,
         segmentation: segmentation.as_ref(),
         affine: o.routes.affine,
+        nonrigid: o.routes.nonrigid,
     })
     .unwrap()
     .expect("two sources");

@@ -1,7 +1,7 @@
 //! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
 
 use super::held_out::{HeldOutInputs, held_out_routes_cached};
-use super::rigid_route::rigid_route_weighed;
+use super::rigid_route::{RigidSteps, rigid_route_weighed};
 use super::{
     ClassifierReport, FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation,
     Route, RouteLabels, classifier_route, fuse_routes_with, parts_route, snap_labels,
@@ -44,6 +44,12 @@ pub struct RouteOptions {
     /// Whether the rigid route relaxes its similarity to an affine map before reading the
     /// labels ([`super::refine_affine`]). Default `true`.
     pub affine: bool,
+    /// Whether the rigid route then deforms its source onto each shape before reading the
+    /// labels ([`super::refine_nonrigid`]: an embedded deformation graph whose stiffness is
+    /// lowered while held-out samples improve). Default `false` (docs/PROPAGATION.md,
+    /// "the non-rigid step"). Options saved without it read as `false`.
+    #[serde(default)]
+    pub nonrigid: bool,
     /// The map route ([`super::map_route`]): every unlabelled shape re-labelled through a
     /// point map to its nearest source, taken on the shapes where the routes' agreement ranks
     /// the map as the most accurate route (near-isometric collections). Reads the shapes'
@@ -66,6 +72,7 @@ impl Default for RouteOptions {
             rigid: true,
             snap_band: 0.0,
             affine: true,
+            nonrigid: false,
             map: true,
             classifier: false,
         }
@@ -81,8 +88,17 @@ impl RouteOptions {
             rigid: false,
             snap_band: 0.0,
             affine: true,
+            nonrigid: false,
             map: false,
             classifier: false,
+        }
+    }
+
+    /// The rigid route's refinement steps ([`RigidSteps`]) these options ask for.
+    pub fn rigid_steps(&self) -> RigidSteps {
+        RigidSteps {
+            affine: self.affine,
+            nonrigid: self.nonrigid,
         }
     }
 
@@ -404,7 +420,7 @@ pub fn fuse_propagation(
         let (rigid, warnings) = rigid_route_weighed(
             meshes,
             annotations,
-            options.affine,
+            options.rigid_steps(),
             &targets,
             &propagation.rigid,
             rigid_poses,
@@ -431,6 +447,7 @@ pub fn fuse_propagation(
         routes: &names,
         segmentation,
         affine: options.affine,
+        nonrigid: options.nonrigid,
     };
     let timer = crate::stage_timer::stage("held-out routes on the sources");
     report.held_out_runs = held_out_routes_cached(

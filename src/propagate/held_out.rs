@@ -1,7 +1,7 @@
 //! [`held_out_accuracy`]: each route's accuracy measured on the sources themselves, every
 //! source's labels carried to it from the other sources.
 
-use super::rigid_route::{RigidCache, rigid_route_weighed};
+use super::rigid_route::{RigidCache, RigidSteps, rigid_route_weighed};
 use super::solve::propagate_labels_from;
 use super::{PropagateError, PropagateOptions, Propagation, Route, parts_route};
 use crate::graph::{Cosegmentation, ShapeGraph};
@@ -28,6 +28,8 @@ pub struct HeldOutInputs<'a> {
     pub segmentation: Option<&'a Cosegmentation>,
     /// Whether the rigid route takes its affine step.
     pub affine: bool,
+    /// Whether the rigid route takes its non-rigid step ([`super::refine_nonrigid`]).
+    pub nonrigid: bool,
 }
 
 /// Each route's accuracy on the sources, measured against the user's own labels: every source
@@ -101,7 +103,9 @@ pub(crate) fn held_out_routes_cached(
         routes,
         segmentation,
         affine,
+        nonrigid,
     } = *inputs;
+    let steps = RigidSteps { affine, nonrigid };
     let n = annotations.len();
     let sources: Vec<usize> = (0..n)
         .filter(|&i| {
@@ -165,7 +169,7 @@ pub(crate) fn held_out_routes_cached(
                     let mut r = rigid_route_weighed(
                         meshes,
                         &ann,
-                        affine,
+                        steps,
                         &[s],
                         rigid,
                         rigid_poses,

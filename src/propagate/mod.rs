@@ -32,6 +32,7 @@ mod options;
 mod part_scores;
 mod parts_route;
 mod refine_affine;
+mod refine_nonrigid;
 mod rigid_route;
 mod snap_labels;
 mod solve;
@@ -51,9 +52,10 @@ pub use options::PropagateOptions;
 pub use part_scores::PartScore;
 pub use parts_route::parts_route;
 pub use refine_affine::{AffineFit, AffineMap, refine_affine};
+pub use refine_nonrigid::{NonrigidFit, refine_nonrigid};
 pub use rigid_route::{
-    RigidAlternative, choose_rigid_alternative, rigid_alternatives, rigid_choice_is_outlier,
-    rigid_route,
+    RigidAlternative, RigidSteps, choose_rigid_alternative, rigid_alternatives,
+    rigid_choice_is_outlier, rigid_route,
 };
 pub use snap_labels::snap_labels;
 pub use solve::{Propagation, UpdateStats, propagate_labels};

@@ -3,7 +3,8 @@
 
 use super::RouteLabels;
 use super::fuse_routes::cohen_kappa;
-use super::refine_affine::refine_affine_reading;
+use super::refine_affine::{AffineMap, refine_affine_reading};
+use super::refine_nonrigid::refine_nonrigid_reading;
 use crate::align::{
     AlignError, AlignOptions, Candidate, CollectionAlignment, FrameCase, Prepared, RegisterOptions,
     Registration, Similarity, SurfaceIndex, align_collection, nearest_corner,
@@ -25,12 +26,14 @@ use std::sync::{Arc, Mutex};
 /// ρ)`, `d` the distance, `ρ` the registration's residual in the same units), so a limb that
 /// the alignment leaves in the air votes weakly; per shape: the registration's inlier share.
 ///
-/// With `affine`, the chosen similarity is then relaxed to an affine map
+/// With `steps.affine`, the chosen similarity is then relaxed to an affine map
 /// ([`super::refine_affine`]) before the labels are read, so that a shape of other proportions
-/// (a taller back, a wider seat) overlays its source part on part.
+/// (a taller back, a wider seat) overlays its source part on part; with `steps.nonrigid`, the
+/// source is then deformed onto the shape ([`super::refine_nonrigid`]) and the labels are
+/// read off the deformed source's surface. A `bool` reads as the affine step alone.
 ///
 /// Inputs: `meshes` (#shapes, graph order), `annotations` (one per shape, `Some` per-vertex
-/// labels on the sources), `affine`. Output: [`RouteLabels`] (empty on the sources) and, per shape that
+/// labels on the sources), `steps`. Output: [`RouteLabels`] (empty on the sources) and, per shape that
 /// could not be registered onto any source, a warning.
 ///
 /// See also: [`crate::align::register_pair`], [`super::fuse_routes`].
@@ -40,12 +43,32 @@ use std::sync::{Arc, Mutex};
 pub fn rigid_route(
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
-    affine: bool,
+    steps: impl Into<RigidSteps>,
 ) -> (RouteLabels, Vec<String>) {
     let targets: Vec<usize> = (0..meshes.len())
         .filter(|&i| annotations[i].is_none())
         .collect();
-    rigid_route_to(meshes, annotations, affine, &targets)
+    rigid_route_to(meshes, annotations, steps.into(), &targets)
+}
+
+/// Which steps relax the rigid route's similarity before the labels are read
+/// ([`rigid_route`]). `From<bool>`: the affine step alone, or none.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
+pub struct RigidSteps {
+    /// Relax the similarity to an affine map ([`super::refine_affine`]).
+    pub affine: bool,
+    /// Then deform the source onto the shape ([`super::refine_nonrigid`]), from the affine
+    /// map (or the similarity without the affine step).
+    pub nonrigid: bool,
+}
+
+impl From<bool> for RigidSteps {
+    fn from(affine: bool) -> Self {
+        RigidSteps {
+            affine,
+            nonrigid: false,
+        }
+    }
 }
 
 /// [`rigid_route`] on the unlabelled shapes `targets` only (the others get no vote): the
@@ -53,10 +76,10 @@ pub fn rigid_route(
 pub(crate) fn rigid_route_to(
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
-    affine: bool,
+    steps: RigidSteps,
     targets: &[usize],
 ) -> (RouteLabels, Vec<String>) {
-    rigid_route_cached(meshes, annotations, affine, targets, &RigidCache::default())
+    rigid_route_cached(meshes, annotations, steps, targets, &RigidCache::default())
 }
 
 /// What the rigid route learns of one (source, target) pair that does not depend on the
@@ -72,7 +95,7 @@ struct PairFit {
 }
 
 /// Per target vertex the source vertex it reads and its distance to the source's surface, and
-/// the pair's residual after the affine step.
+/// the pair's residual after the refinement steps.
 type Nearest = (Vec<i32>, Vec<f64>, f64);
 
 /// The rigid route's label-independent work, kept between propagations of one collection:
@@ -81,7 +104,7 @@ type Nearest = (Vec<i32>, Vec<f64>, f64);
 /// instead of a registration and a nearest-point search per pair. Results are those of an
 /// empty cache, bit for bit: what is kept is exactly what would be recomputed.
 ///
-/// Entries are keyed by the shapes' indices and vertex counts and the affine step; a cache
+/// Entries are keyed by the shapes' indices and vertex counts and the refinement steps; a cache
 /// serves one collection of meshes (a [`super::Propagation`] keeps one for its graph).
 #[derive(Debug, Default)]
 pub(crate) struct RigidCache {
@@ -120,8 +143,8 @@ impl std::fmt::Debug for SourceIndex {
     }
 }
 
-/// (source, target, source vertices, target vertices, affine step).
-type PairKey = (usize, usize, usize, usize, bool);
+/// (source, target, source vertices, target vertices, refinement steps).
+type PairKey = (usize, usize, usize, usize, RigidSteps);
 
 impl Clone for RigidCache {
     fn clone(&self) -> Self {
@@ -235,13 +258,13 @@ impl RigidCache {
         self.lock_sources().entry(key).or_insert(made).clone()
     }
 
-    fn key(meshes: &[TriMesh], s: usize, i: usize, affine: bool) -> PairKey {
+    fn key(meshes: &[TriMesh], s: usize, i: usize, steps: RigidSteps) -> PairKey {
         (
             s,
             i,
             meshes[s].vertex_count(),
             meshes[i].vertex_count(),
-            affine,
+            steps,
         )
     }
 
@@ -251,9 +274,9 @@ impl RigidCache {
         meshes: &[TriMesh],
         s: usize,
         i: usize,
-        affine: bool,
+        steps: RigidSteps,
     ) -> Result<Registration, String> {
-        let key = Self::key(meshes, s, i, affine);
+        let key = Self::key(meshes, s, i, steps);
         if let Some(f) = self.lock().get(&key) {
             return f.registration.clone();
         }
@@ -279,17 +302,17 @@ impl RigidCache {
 
     /// Per vertex of target `i`: the vertex of source `s` it reads its label from and its
     /// distance to the source's surface, after the registration's candidate pose `pose` (and
-    /// the affine step); computed on the first call.
+    /// the refinement steps); computed on the first call.
     fn nearest(
         &self,
         meshes: &[TriMesh],
         s: usize,
         i: usize,
-        affine: bool,
+        steps: RigidSteps,
         pose: &Candidate,
         index_of_pose: usize,
     ) -> Result<Nearest, String> {
-        let key = Self::key(meshes, s, i, affine);
+        let key = Self::key(meshes, s, i, steps);
         if let Some(n) = self
             .lock()
             .get(&key)
@@ -305,8 +328,10 @@ impl RigidCache {
         let nearest_labels = |target: &TriMesh, transform: &Similarity| {
             nearest_point_vertex_labels_in(&source.surface, &meshes[s], &index, target, transform)
         };
-        let carried = if affine {
-            let (fit, closest) = refine_affine_reading(
+        let mut map = AffineMap::from_similarity(&pose.transform);
+        let mut closest = None;
+        if steps.affine {
+            let (fit, points) = refine_affine_reading(
                 &meshes[s],
                 &source.surface,
                 &meshes[i],
@@ -318,23 +343,35 @@ impl RigidCache {
                 // improvement onto the registration's residual.
                 residual = pose.residual * (fit.residual / fit.start_residual).min(1.0);
             }
-            match closest {
-                // The fit paired every target vertex with its closest source point under the
-                // map it returns: the nearest-point labels of the mapped target, already made.
-                Some(closest) => {
-                    let faces = meshes[s].faces();
-                    Ok(closest
-                        .iter()
-                        .map(|c| (nearest_corner(faces, c) as i32, c.distance))
-                        .unzip())
-                }
-                None => match meshes[i].map_positions(|p| fit.map.apply(p)) {
-                    Ok(mapped) => nearest_labels(&mapped, &Similarity::identity()),
-                    Err(_) => nearest_labels(&meshes[i], &pose.transform),
-                },
+            map = fit.map;
+            closest = points;
+        }
+        if steps.nonrigid
+            && let Some((fit, points)) =
+                refine_nonrigid_reading(&meshes[s], &meshes[i], &map, AFFINE_TRIM)
+        {
+            if fit.start_residual > 0.0 && fit.residual.is_finite() {
+                // Its own chamfer (samples against the deformed samples), so its own ratio.
+                residual *= (fit.residual / fit.start_residual).min(1.0);
             }
-        } else {
-            nearest_labels(&meshes[i], &pose.transform)
+            // The labels are read off the deformed source: same faces, same vertices.
+            closest = Some(points);
+        }
+        let carried = match closest {
+            // The last step paired every target vertex with its closest source point under
+            // the map (and deformation) it returns: the nearest-point labels, already made.
+            Some(closest) => {
+                let faces = meshes[s].faces();
+                Ok(closest
+                    .iter()
+                    .map(|c| (nearest_corner(faces, c) as i32, c.distance))
+                    .unzip())
+            }
+            None if steps.affine => match meshes[i].map_positions(|p| map.apply(p)) {
+                Ok(mapped) => nearest_labels(&mapped, &Similarity::identity()),
+                Err(_) => nearest_labels(&meshes[i], &pose.transform),
+            },
+            None => nearest_labels(&meshes[i], &pose.transform),
         }
         .map(|(v, d)| (v, d, residual))
         .map_err(|e| e.to_string())?;
@@ -351,12 +388,12 @@ impl RigidCache {
 pub(crate) fn rigid_route_cached(
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
-    affine: bool,
+    steps: RigidSteps,
     targets: &[usize],
     cache: &RigidCache,
 ) -> (RouteLabels, Vec<String>) {
     let (alternatives, warnings) =
-        rigid_alternatives_cached(meshes, annotations, affine, targets, cache, false);
+        rigid_alternatives_cached(meshes, annotations, steps, targets, cache, false);
     let chosen: Vec<usize> = vec![0; meshes.len()];
     (choose_alternatives(alternatives, &chosen), warnings)
 }
@@ -371,7 +408,7 @@ pub(crate) fn rigid_route_cached(
 pub(crate) fn rigid_route_weighed<'a>(
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
-    affine: bool,
+    steps: RigidSteps,
     targets: &[usize],
     cache: &RigidCache,
     weigh_poses: bool,
@@ -379,7 +416,7 @@ pub(crate) fn rigid_route_weighed<'a>(
     areas: &[&[f64]],
 ) -> (RouteLabels, Vec<String>) {
     let (mut alternatives, warnings) =
-        rigid_alternatives_cached(meshes, annotations, affine, targets, cache, false);
+        rigid_alternatives_cached(meshes, annotations, steps, targets, cache, false);
     let outliers: Vec<usize> = targets
         .iter()
         .copied()
@@ -392,7 +429,7 @@ pub(crate) fn rigid_route_weighed<'a>(
         .collect();
     if !outliers.is_empty() {
         let (more, _) =
-            rigid_alternatives_cached(meshes, annotations, affine, &outliers, cache, true);
+            rigid_alternatives_cached(meshes, annotations, steps, &outliers, cache, true);
         for (i, m) in more.into_iter().enumerate() {
             if !m.is_empty() {
                 alternatives[i] = m;
@@ -447,7 +484,7 @@ pub struct RigidAlternative {
 pub fn rigid_alternatives(
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
-    affine: bool,
+    steps: impl Into<RigidSteps>,
     all: bool,
 ) -> (Vec<Vec<RigidAlternative>>, Vec<String>) {
     let targets: Vec<usize> = (0..meshes.len())
@@ -456,7 +493,7 @@ pub fn rigid_alternatives(
     rigid_alternatives_cached(
         meshes,
         annotations,
-        affine,
+        steps.into(),
         &targets,
         &RigidCache::default(),
         all,
@@ -468,7 +505,7 @@ pub fn rigid_alternatives(
 pub(crate) fn rigid_alternatives_cached(
     meshes: &[TriMesh],
     annotations: &[Option<Vec<i32>>],
-    affine: bool,
+    steps: RigidSteps,
     targets: &[usize],
     cache: &RigidCache,
     all: bool,
@@ -488,7 +525,7 @@ pub(crate) fn rigid_alternatives_cached(
             let mut registered: Vec<(usize, Registration)> = Vec::new();
             let mut error = String::new();
             for &s in &sources {
-                match cache.registration(meshes, s, i, affine) {
+                match cache.registration(meshes, s, i, steps) {
                     Ok(r) => registered.push((s, r)),
                     Err(e) => error = e,
                 }
@@ -525,7 +562,7 @@ pub(crate) fn rigid_alternatives_cached(
                 };
                 let pose = reg.candidates.get(c).unwrap_or(&first);
                 let radius = rms_radius(&meshes[s]);
-                match cache.nearest(meshes, s, i, affine, pose, c) {
+                match cache.nearest(meshes, s, i, steps, pose, c) {
                     Ok((from, dist, residual)) => {
                         let labels = from.iter().map(|&v| ann[v as usize]).collect();
                         // The residual is in source RMS radii; the distances in source units.
