@@ -170,7 +170,7 @@ pub fn refine_nonrigid(
         ) else {
             break;
         };
-        if !(h.residual < best.0) {
+        if h.residual.is_nan() || best.0.is_nan() || h.residual >= best.0 {
             break;
         }
         best = (h.residual, state.clone(), f.residual, level + 1);
@@ -408,7 +408,7 @@ impl Problem<'_> {
         for dir in [forward, backward] {
             let kept = trimmed(&dir, self.trim);
             let total: f64 = kept.iter().map(|&k| dir[k].2).sum();
-            if !(total > 0.0) {
+            if total.is_nan() || total <= 0.0 {
                 return None;
             }
             residual += kept.iter().map(|&k| dir[k].2 * dir[k].3).sum::<f64>() / total / 2.0;
