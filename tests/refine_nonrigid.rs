@@ -1,5 +1,7 @@
 //! `propagate::refine_nonrigid` and the rigid route's non-rigid step on synthetic shapes.
 
+mod common;
+
 use coseg::align::SurfaceIndex;
 use coseg::mesh::TriMesh;
 use coseg::propagate::{AffineMap, RigidSteps, refine_nonrigid, rigid_route};
@@ -212,16 +214,7 @@ fn degenerate_inputs_keep_the_start_or_deform_without_panic() {
         vec![[0, 1, 2]],
     )
     .unwrap();
-    let tetra = TriMesh::new(
-        vec![
-            [0.0, 0.0, 0.0],
-            [1.0, 0.0, 0.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 0.0, 1.0],
-        ],
-        vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
-    )
-    .unwrap();
+    let tetra = common::mesh::tetrahedron();
     let identity = AffineMap {
         matrix: [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]],
         translation: [0.0, 0.0, 0.0],

@@ -209,8 +209,9 @@ fn correspondences(
     })
 }
 
-/// Indices of the pairs kept: the nearest ones holding a share `trim` of the weight.
-fn trimmed(pairs: &[([f64; 3], [f64; 3], f64, f64)], trim: f64) -> Vec<usize> {
+/// Indices of the pairs kept: the nearest ones holding a share `trim` of the weight (each
+/// pair: two ends, its weight, its distance; ties by index). The non-rigid step trims the same way.
+pub(super) fn trimmed<A, B>(pairs: &[(A, B, f64, f64)], trim: f64) -> Vec<usize> {
     let mut order: Vec<usize> = (0..pairs.len()).collect();
     order.sort_by(|&a, &b| pairs[a].3.total_cmp(&pairs[b].3).then(a.cmp(&b)));
     let total: f64 = pairs.iter().map(|p| p.2).sum();

@@ -3,7 +3,7 @@
 //! lowered while held-out samples keep improving), so that shapes of one class whose parts
 //! differ in length or tilt overlay part on part.
 
-use super::refine_affine::AffineMap;
+use super::refine_affine::{AffineMap, trimmed};
 use crate::align::{SurfaceIndex, SurfacePoint};
 use crate::mesh::TriMesh;
 use faer::linalg::solvers::Solve;
@@ -546,21 +546,4 @@ impl Normal {
             }
         }
     }
-}
-
-/// Indices of the pairs kept: the nearest ones holding a share `trim` of the weight.
-fn trimmed<T>(pairs: &[(usize, T, f64, f64)], trim: f64) -> Vec<usize> {
-    let mut order: Vec<usize> = (0..pairs.len()).collect();
-    order.sort_by(|&a, &b| pairs[a].3.total_cmp(&pairs[b].3).then(a.cmp(&b)));
-    let total: f64 = pairs.iter().map(|p| p.2).sum();
-    let mut kept = Vec::with_capacity(order.len());
-    let mut acc = 0.0;
-    for k in order {
-        if acc >= trim * total {
-            break;
-        }
-        acc += pairs[k].2;
-        kept.push(k);
-    }
-    kept
 }
