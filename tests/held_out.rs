@@ -4,7 +4,7 @@
 use coseg::bands::equal_count_bands;
 use coseg::graph::{GraphOptions, ShapeGraph, ShapeNode};
 use coseg::propagate::{
-    HeldOutInputs, PropagateOptions, Route, held_out_accuracy, held_out_routes,
+    HeldOutInputs, PropagateOptions, RigidSteps, Route, held_out_accuracy, held_out_routes,
 };
 
 /// Three shapes with the same 40-vertex band table.
@@ -32,8 +32,10 @@ fn affinity_only<'a>(
         propagate,
         routes: &[Route::Affinity],
         segmentation: None,
-        affine: true,
-        nonrigid: false,
+        steps: RigidSteps {
+            affine: true,
+            nonrigid: false,
+        },
     }
 }
 

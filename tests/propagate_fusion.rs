@@ -529,8 +529,7 @@ fn a_fusion_after_an_update_keeping_the_registrations_equals_one_without_them() 
         propagate: &o.propagate,
         routes: &names,
         segmentation: segmentation.as_ref(),
-        affine: o.routes.affine,
-        nonrigid: o.routes.nonrigid,
+        steps: o.routes.rigid_steps(),
     })
     .unwrap()
     .expect("two sources");

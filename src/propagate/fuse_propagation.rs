@@ -446,8 +446,7 @@ pub fn fuse_propagation(
         propagate,
         routes: &names,
         segmentation,
-        affine: options.affine,
-        nonrigid: options.nonrigid,
+        steps: options.rigid_steps(),
     };
     let timer = crate::stage_timer::stage("held-out routes on the sources");
     report.held_out_runs = held_out_routes_cached(

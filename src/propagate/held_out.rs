@@ -26,10 +26,8 @@ pub struct HeldOutInputs<'a> {
     pub routes: &'a [Route],
     /// The parts route's co-segmentation (`None`: the parts route gives no labels).
     pub segmentation: Option<&'a Cosegmentation>,
-    /// Whether the rigid route takes its affine step.
-    pub affine: bool,
-    /// Whether the rigid route takes its non-rigid step ([`super::refine_nonrigid`]).
-    pub nonrigid: bool,
+    /// The rigid route's refinement steps (affine, non-rigid; [`RigidSteps`]).
+    pub steps: RigidSteps,
 }
 
 /// Each route's accuracy on the sources, measured against the user's own labels: every source
@@ -102,10 +100,8 @@ pub(crate) fn held_out_routes_cached(
         propagate,
         routes,
         segmentation,
-        affine,
-        nonrigid,
+        steps,
     } = *inputs;
-    let steps = RigidSteps { affine, nonrigid };
     let n = annotations.len();
     let sources: Vec<usize> = (0..n)
         .filter(|&i| {
