@@ -293,6 +293,17 @@ fn coseg_propagate_on_the_shipped_goblets() {
         serde_json::from_str(&std::fs::read_to_string(o1.join("summary.json")).unwrap()).unwrap();
     assert_eq!(summary["sources"], serde_json::json!(["goblets_00"]));
     assert_eq!(summary["shapes"].as_array().unwrap().len(), 6);
+    // The parts route's part tree is kept in the cache as `coseg segment` keeps it, and the
+    // rerun reads it instead of growing it again: the same bytes below.
+    let trees = std::fs::read_dir(out.join("cache"))
+        .unwrap()
+        .filter(|e| {
+            let p = e.as_ref().unwrap().path();
+            p.extension()
+                .is_some_and(|x| x == coseg::cache::PART_TREE_EXTENSION)
+        })
+        .count();
+    assert_eq!(trees, 1, "one part-tree entry in the cache");
     // A rerun writes the same bytes.
     let o2 = out.join("b");
     assert!(run(&o2).status.success());

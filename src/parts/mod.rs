@@ -57,6 +57,7 @@ pub use geometric_part_tree::{
 pub use mirror_pairs::{Likeness, MirrorPair, MirrorPlane, mirror_pairs, mirror_plane};
 pub use paired_advantage::{PairedAdvantage, paired_advantage};
 pub use part_cues::{PartCues, PartCuesResult, load_or_compute_part_cues};
+pub(crate) use part_tree_cache::segment_collection_cached_sharing;
 pub use part_tree_cache::{part_tree_key, segment_collection_cached};
 pub use parts_report::PartsReport;
 pub use segment_collection::{

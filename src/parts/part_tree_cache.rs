@@ -24,11 +24,12 @@
 
 use super::adaptive_cosegment::{AdaptiveCosegmentation, PartTree, StopReason};
 use super::aligned_extrinsic_bands::concat_tables;
+use super::choose_features::SharedAlignment;
 use super::choose_features::{FeatureChoice, FeatureSet};
 use super::paired_advantage::PairedAdvantage;
 use super::segment_collection::{
     PartTreeStage, PartsFrom, SegmentCollectionOptions, SegmentTimes, SegmentedCollection,
-    cut_part_tree, part_tree, segment_collection,
+    cut_part_tree, part_tree_sharing, segment_collection_sharing,
 };
 use super::spectral_agreement::SpectralAgreement;
 use crate::align::FrameCase;
@@ -39,6 +40,7 @@ use crate::cache::{
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
+use crate::spectral::HeatSmoother;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 
@@ -378,11 +380,11 @@ fn restore(
     })
 }
 
-/// [`segment_collection`] through the part-tree cache in `cache_dir`: with parts from geometry
+/// [`segment_collection`](super::segment_collection) through the part-tree cache in `cache_dir`: with parts from geometry
 /// (the default), the part tree of these shapes and options ([`part_tree_key`];
 /// `shape_keys[i]` is shape `i`'s per-shape key) is read from its entry when there is one and
-/// only cut ([`cut_part_tree`]), else grown ([`part_tree`]), written, and cut. The result is
-/// [`segment_collection`]'s, bit for bit, either way. In the other modes (equal-area regions,
+/// only cut ([`cut_part_tree`]), else grown ([`part_tree`](super::part_tree)), written, and cut. The result is
+/// [`segment_collection`](super::segment_collection)'s, bit for bit, either way. In the other modes (equal-area regions,
 /// adaptive parts) nothing is cached and the outcome is `None`.
 ///
 /// The outcome says where the tree came from: [`CacheOutcome::Hit`] (read, only cut),
@@ -390,7 +392,7 @@ fn restore(
 /// trusted, with the reason, also among the result's warnings). An entry that cannot be
 /// written is a warning too; the result does not depend on it.
 ///
-/// Errors: those of [`segment_collection`]; [`GraphError::BadOption`] when `shape_keys` or
+/// Errors: those of [`segment_collection`](super::segment_collection); [`GraphError::BadOption`] when `shape_keys` or
 /// `meshes` are not one per node.
 pub fn segment_collection_cached(
     nodes: Vec<ShapeNode>,
@@ -399,10 +401,25 @@ pub fn segment_collection_cached(
     cache_dir: &Path,
     shape_keys: &[ShapeKey],
 ) -> Result<(SegmentedCollection, Option<CacheOutcome>), GraphError> {
+    segment_collection_cached_sharing(nodes, meshes, options, cache_dir, shape_keys, None, None)
+}
+
+/// [`segment_collection_cached`] reading the caller's heat smoothers and collection alignment
+/// where a tree is grown ([`segment_collection_sharing`](super::segment_collection_sharing)): the same result, bit for bit.
+pub(crate) fn segment_collection_cached_sharing(
+    nodes: Vec<ShapeNode>,
+    meshes: &[TriMesh],
+    options: &SegmentCollectionOptions,
+    cache_dir: &Path,
+    shape_keys: &[ShapeKey],
+    smoothers: Option<&[HeatSmoother]>,
+    alignment: Option<SharedAlignment<'_>>,
+) -> Result<(SegmentedCollection, Option<CacheOutcome>), GraphError> {
     let geometry =
         options.parts.is_some() && matches!(options.parts_from, PartsFrom::Geometry { .. });
     if !geometry {
-        return Ok((segment_collection(nodes, meshes, options)?, None));
+        let result = segment_collection_sharing(nodes, meshes, options, smoothers, alignment)?;
+        return Ok((result, None));
     }
     if shape_keys.len() != nodes.len() || meshes.len() != nodes.len() {
         return Err(GraphError::BadOption(format!(
@@ -445,7 +462,7 @@ pub fn segment_collection_cached(
         None => CacheOutcome::Miss,
     };
     let kept = nodes.clone();
-    let stage = part_tree(nodes, meshes, options)?;
+    let stage = part_tree_sharing(nodes, meshes, options, smoothers, alignment)?;
     match stored(&stage, kept, options) {
         Ok(s) => {
             let written = std::fs::create_dir_all(cache_dir)

@@ -1012,7 +1012,19 @@ pub fn part_tree(
     meshes: &[TriMesh],
     options: &SegmentCollectionOptions,
 ) -> Result<PartTreeStage, GraphError> {
-    let prepared = prepare(nodes, meshes, options, None, None)?;
+    part_tree_sharing(nodes, meshes, options, None, None)
+}
+
+/// [`part_tree`] reading the caller's heat smoothers and collection alignment, as
+/// [`segment_collection_sharing`] does: the same tree.
+pub(crate) fn part_tree_sharing(
+    nodes: Vec<ShapeNode>,
+    meshes: &[TriMesh],
+    options: &SegmentCollectionOptions,
+    shared: Option<&[HeatSmoother]>,
+    alignment: Option<SharedAlignment<'_>>,
+) -> Result<PartTreeStage, GraphError> {
+    let prepared = prepare(nodes, meshes, options, shared, alignment)?;
     if prepared.geometry.is_none() {
         return Err(GraphError::BadOption(
             "a part tree is grown for parts from geometry (--parts-from geometry)".into(),

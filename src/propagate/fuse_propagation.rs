@@ -11,8 +11,8 @@ use crate::mesh::TriMesh;
 use crate::option_range::non_negative;
 use crate::parts::{
     AdaptiveCosegmentation, FeatureSet, PartsFrom, PartsRequest, SegmentCollectionOptions,
-    SegmentedCollection, SharedAlignment, StopReason, segment_collection_sharing,
-    snap_part_boundaries,
+    SegmentedCollection, SharedAlignment, StopReason, segment_collection_cached_sharing,
+    segment_collection_sharing, snap_part_boundaries,
 };
 use crate::pipeline::ShapePipelineOptions;
 use crate::spectral::HeatSmoother;
@@ -122,6 +122,12 @@ pub struct CollectionParts {
     /// Whether the per-shape pipeline holds the intrinsic family alone (no extrinsic, SDF or
     /// user columns): what the parts read when their families are taken as given.
     intrinsic_pipeline: bool,
+    /// The per-shape pipeline the nodes were computed with: with `cache`, what keys each
+    /// shape's part-tree entry ([`crate::pipeline::shape_key`]).
+    pipeline: ShapePipelineOptions,
+    /// Where the bare co-segmentation's part tree is kept between runs (the part cues' folder:
+    /// the cache of the per-shape stage); `None`: grown every run.
+    cache: Option<PathBuf>,
     /// The bare co-segmentation, once made.
     data: Option<DataParts>,
     /// Per number of labels above the data's count of parts: the finer co-segmentation the
@@ -147,8 +153,11 @@ impl CollectionParts {
     /// with the intrinsic family alone in the pipeline the families are chosen from the data
     /// (as `coseg segment` without `--features`), otherwise the pipeline's families are taken
     /// as given (its weights, up direction and mirror-invariant columns, as `coseg segment
-    /// --features …`); `cue_cache`: where each shape's part cues are kept (`None`: computed
-    /// every run).
+    /// --features …`); `cue_cache`: the cache folder where each shape's part cues and the
+    /// collection's part tree are kept, as `coseg segment` keeps them
+    /// ([`crate::parts::segment_collection_cached`]: a warm run with the same shapes reads
+    /// the tree and only cuts it, with the same result bit for bit); `None`: computed every
+    /// run.
     pub fn new(
         nodes: Vec<ShapeNode>,
         pipeline: &ShapePipelineOptions,
@@ -161,6 +170,7 @@ impl CollectionParts {
         // `coseg segment`'s bare options (`SegmentJob::collection_options` with no mode flag):
         // parts from geometry, their number chosen from the part tree, the families chosen
         // from the data unless the pipeline has others than the intrinsic one.
+        let cache = cue_cache.clone();
         let mut options = SegmentCollectionOptions {
             graph: *graph,
             cue_cache,
@@ -171,6 +181,8 @@ impl CollectionParts {
             nodes,
             options,
             intrinsic_pipeline,
+            pipeline: pipeline.clone(),
+            cache,
             data: None,
             made: BTreeMap::new(),
         }
@@ -249,13 +261,33 @@ impl CollectionParts {
         alignment: Option<SharedAlignment<'_>>,
     ) -> Result<&DataParts, GraphError> {
         if self.data.is_none() {
-            let s = segment_collection_sharing(
-                self.nodes.clone(),
-                meshes,
-                &self.options,
-                smoothers,
-                alignment,
-            )?;
+            let s = match &self.cache {
+                // The nodes' own keys: a part-tree entry written by `coseg segment` on the
+                // same shapes under the same options is this tree too.
+                Some(dir) if meshes.len() == self.nodes.len() => {
+                    let keys: Vec<_> = meshes
+                        .iter()
+                        .map(|m| crate::pipeline::shape_key(m, &self.pipeline))
+                        .collect();
+                    segment_collection_cached_sharing(
+                        self.nodes.clone(),
+                        meshes,
+                        &self.options,
+                        dir,
+                        &keys,
+                        smoothers,
+                        alignment,
+                    )?
+                    .0
+                }
+                _ => segment_collection_sharing(
+                    self.nodes.clone(),
+                    meshes,
+                    &self.options,
+                    smoothers,
+                    alignment,
+                )?,
+            };
             let intrinsic = self.read_intrinsic(&s);
             let tree = s
                 .adaptive
