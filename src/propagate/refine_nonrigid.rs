@@ -148,25 +148,37 @@ pub fn refine_nonrigid(
     };
     let start_residual = first.residual;
     let mut best = (held.residual, state.clone(), first.residual, 0);
+    // The pairs of the current state, when made: a step that ends a level (no solve after
+    // it) leaves them for the level's score and that score for the next level's first step.
+    let mut at_state = Some(first);
     let mut stiffness = START_STIFFNESS;
     for level in 0..MAX_LEVELS {
         let mut last = f64::INFINITY;
         for _ in 0..STEPS_PER_LEVEL {
-            let Some(pairs) = score(&state, &s_fit, &t_fit, &s_fit) else {
+            let Some(pairs) = at_state
+                .take()
+                .or_else(|| score(&state, &s_fit, &t_fit, &s_fit))
+            else {
                 break;
             };
             if pairs.residual >= last {
+                at_state = Some(pairs);
                 break;
             }
             last = pairs.residual;
             match problem.solve(&pairs, stiffness) {
                 Some(next) => state = next,
-                None => break,
+                None => {
+                    at_state = Some(pairs);
+                    break;
+                }
             }
         }
         let (Some(h), Some(f)) = (
             score(&state, &s_held, &t_held, &all_source),
-            score(&state, &s_fit, &t_fit, &s_fit),
+            at_state
+                .take()
+                .or_else(|| score(&state, &s_fit, &t_fit, &s_fit)),
         ) else {
             break;
         };
@@ -174,6 +186,7 @@ pub fn refine_nonrigid(
             break;
         }
         best = (h.residual, state.clone(), f.residual, level + 1);
+        at_state = Some(f);
         stiffness *= STIFFNESS_STEP;
     }
     let (_, state, residual, levels) = best;
@@ -281,7 +294,13 @@ fn skin_of(p: [f64; 3], nodes: &[[f64; 3]]) -> Skin {
         .enumerate()
         .map(|(k, g)| (dist(p, *g), k))
         .collect();
-    near.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+    let order = |a: &(f64, usize), b: &(f64, usize)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1));
+    // Only the nearest nodes and the next one are read: select them, then order those.
+    if near.len() > NEIGHBOURS + 1 {
+        near.select_nth_unstable_by(NEIGHBOURS, order);
+        near.truncate(NEIGHBOURS + 1);
+    }
+    near.sort_by(order);
     let k = NEIGHBOURS.min(near.len());
     let next = near.get(k).map_or(f64::INFINITY, |x| x.0);
     let mut skin: Skin = near[..k]
