@@ -46,8 +46,10 @@ pub struct RouteOptions {
     pub affine: bool,
     /// Whether the rigid route then deforms its source onto each shape before reading the
     /// labels ([`super::refine_nonrigid`]: an embedded deformation graph whose stiffness is
-    /// lowered while held-out samples improve). Default `false` (docs/PROPAGATION.md,
-    /// "the non-rigid step"). Options saved without it read as `false`.
+    /// lowered while held-out samples improve). Default `true`: measured on the shared,
+    /// shipped and held-out generated sets, it lost no set by more than 0.1 point of the
+    /// fused accuracy and gained up to 7.7 (docs/PROPAGATION.md, "the non-rigid step").
+    /// Options saved without it read as `false`, as they were made.
     #[serde(default)]
     pub nonrigid: bool,
     /// The map route ([`super::map_route`]): every unlabelled shape re-labelled through a
@@ -72,7 +74,7 @@ impl Default for RouteOptions {
             rigid: true,
             snap_band: 0.0,
             affine: true,
-            nonrigid: false,
+            nonrigid: true,
             map: true,
             classifier: false,
         }
