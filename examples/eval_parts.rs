@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N]
 //!     [--features F --up AXIS [--normals N]] [--starts N] [--keep-sizes TOL] [--detail]
-//!     [--parts-from adaptive|geometry [--snap-band W]] MODE...
+//!     [--parts-from adaptive|geometry [--snap-band W]] [--all-cuts] MODE...
 //! ```
 //! `--features`/`--up`/`--normals` select the feature families as `coseg segment` does (e.g.
 //! `--features spectral,extrinsic --up y --normals 16`), `--starts` its several starts, `--keep-sizes TOL`
@@ -15,6 +15,9 @@
 //! (region × grouped part, % of a shape) and the best any grouping of the regions could score;
 //! for the part modes the same for the leaves, the merge tree and, when regions were split into
 //! their pieces, each leaf's region of origin.
+//! `--all-cuts` (families, mode `default`): the part tree is grown once and scored at every cut
+//! from 2 to 8 parts (each cut is `coseg segment --parts N` on that tree), with its merge
+//! costs, so that rules choosing the count can be compared offline on the same trees.
 //! `--features auto` chooses the families from the data (`coseg segment` without
 //! `--features`); the mode `default` is the bare `coseg segment` (parts from geometry, their
 //! number chosen from the part tree).
@@ -265,6 +268,10 @@ fn main() -> Res<()> {
     let (mut features, mut up, mut starts) = ("spectral".to_string(), "y".to_string(), 1);
     let mut keep: Option<f64> = None;
     let mut detail = false;
+    // `--all-cuts` (with the mode `default`): the part tree grown once, then scored at every
+    // cut from 2 to 8 parts, and its merge costs printed (to compare ways of choosing the
+    // count on one tree).
+    let mut all_cuts = false;
     let mut normals = 0;
     let mut mirrors = false;
     let mut parts_from = None;
@@ -277,6 +284,7 @@ fn main() -> Res<()> {
             "--normals" => normals = args.next().ok_or("--normals N")?.parse()?,
             "--starts" => starts = args.next().ok_or("--starts N")?.parse()?,
             "--detail" => detail = true,
+            "--all-cuts" => all_cuts = true,
             "--group-mirrors" => mirrors = true,
             "--parts-from" => {
                 parts_from = Some(
@@ -345,6 +353,25 @@ fn main() -> Res<()> {
         o.cue_cache = Some(cache.clone());
         if let Some(tolerance) = keep {
             o.refine_sizes = coseg::graph::RefineSizes::Keep { tolerance };
+        }
+        if all_cuts && mode == "default" && !coseg_set {
+            let stage = coseg::parts::part_tree(loaded.nodes.clone(), &loaded.meshes, &o)?;
+            let costs: Vec<f64> = stage
+                .tree
+                .tree
+                .merges
+                .iter()
+                .map(|m| -m.similarity.clamp(f64::MIN_POSITIVE, 1.0).ln())
+                .collect();
+            println!("  all-cuts costs {costs:?}");
+            for n in 2..=8.min(stage.tree.leaves.tuples.len()) {
+                let mut on = o.clone();
+                on.request_parts(coseg::parts::PartsRequest::Count(n), None);
+                let out = coseg::parts::cut_part_tree(stage.clone(), &loaded.meshes, &on)?;
+                let (p, c) = family_scores(&loaded, &out.segmentation, &folder, false)?;
+                println!("  all-cuts {n}: {:.2} {:.2}", 100.0 * p, 100.0 * c);
+            }
+            continue;
         }
         let t = Instant::now();
         let out = segment_collection(loaded.nodes.clone(), &loaded.meshes, &o)?;
