@@ -19,7 +19,8 @@
 //! library's default fusion of every route, or the band affinity alone; with `all` each route
 //! alone is printed beside the fusion), `--snap-band B`, `--affine true|false` (the rigid
 //! route's affine relaxation), `--nonrigid true|false` (its non-rigid step), `--classifier
-//! true|false` (the classifier refinement, off by default; with it on the fused labels before
+//! true|false` (the classifier refinement, off by default; `--round-trip true|false` the
+//! parts route's round trip in the fusion, off by default; with it on the fused labels before
 //! it are printed as "fused before classifier"), `--size-prior A`,
 //! `--network-weight W`, `--similarity-power P`, `--smoothing-time T`, `--neighbours K`, `--complete-limit N`,
 //! `--part-score affinity|geometric`, `--area-weighted true|false`, `--refit-rounds N`,
@@ -697,6 +698,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--snap-band" => routes.snap_band = val()?.parse()?,
             "--affine" => routes.affine = val()?.parse()?,
             "--classifier" => routes.classifier = val()?.parse()?,
+            "--round-trip" => routes.round_trip = val()?.parse()?,
             "--nonrigid" => routes.nonrigid = val()?.parse()?,
             "--triple" => triple = Some(val()?),
             "--sources" => only = Some(val()?.split(',').map(str::to_string).collect()),

@@ -13,11 +13,13 @@
 //! folders. Scores are area-weighted per vertex (`coseg::evaluate::label_agreement` on the
 //! dumped vertex areas), so on the COSEG chairs, which the harness scores per face, the
 //! dumped and replayed columns differ by that alone; elsewhere a replay of the dumping
-//! build's fusion reproduces the harness's figures. `--per-target`: every target's route
+//! build's fusion reproduces the harness's figures. With `REPLAY_ROUND_TRIP` set, the fusion
+//! reads the parts route's round trip on the sources (`RouteOptions::round_trip`, from the
+//! dumped part ids and the sources' truth). `--per-target`: every target's route
 //! scores, weights and replayed score.
 
 use coseg::evaluate::label_agreement;
-use coseg::propagate::{Route, RouteLabels, fuse_routes_with};
+use coseg::propagate::{RoundTrip, Route, RouteLabels, fuse_routes_with};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -100,7 +102,37 @@ fn replay(
         .filter(|_| run["parts_intrinsic"].as_bool().unwrap_or(false));
     let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas: Vec<&[f64]> = shapes.iter().map(|s| s.areas.as_slice()).collect();
-    let fused = fuse_routes_with(&refs, &areas, held_out.as_deref(), shared);
+    // The parts route's round trip on the sources, as `fuse_propagation` measures it (from
+    // the dumped part ids and the sources' ground truth, which is what they were given).
+    let part_ids: Vec<Vec<i32>> =
+        serde_json::from_value(run["part_ids"].clone()).unwrap_or_default();
+    let mut tally: std::collections::BTreeMap<i32, std::collections::BTreeMap<i32, f64>> =
+        Default::default();
+    for s in vec_i32(&run["sources"]) {
+        let s = s as usize;
+        let Some(ids) = part_ids.get(s) else { continue };
+        for ((&p, &g), &a) in ids.iter().zip(&shapes[s].truth).zip(&shapes[s].areas) {
+            if p >= 0 && g >= 0 {
+                *tally.entry(p).or_default().entry(g).or_insert(0.0) += a;
+            }
+        }
+    }
+    let total: f64 = tally.values().flat_map(|t| t.values()).sum();
+    let right: f64 = tally
+        .values()
+        .map(|t| t.values().copied().fold(0.0, f64::max))
+        .sum();
+    let round_trip = match (position(Route::Parts), position(Route::Affinity)) {
+        (Some(route), Some(partner)) if total > 0.0 && held_out.is_none() => Some(RoundTrip {
+            route,
+            partner,
+            accuracy: right / total,
+        }),
+        _ => None,
+    };
+    // `RouteOptions::round_trip`, off by default: replayed with `REPLAY_ROUND_TRIP` set.
+    let round_trip = round_trip.filter(|_| std::env::var_os("REPLAY_ROUND_TRIP").is_some());
+    let fused = fuse_routes_with(&refs, &areas, held_out.as_deref(), shared, round_trip);
     let sources: Vec<String> = vec_i32(&run["sources"])
         .iter()
         .map(|&s| shapes[s as usize].name.clone())

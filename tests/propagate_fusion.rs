@@ -4,7 +4,9 @@
 mod common;
 
 use coseg::graph::{Cosegmentation, RegionTuple};
-use coseg::propagate::{FusedRoutes, RouteLabels, fuse_routes, fuse_routes_with, parts_route};
+use coseg::propagate::{
+    FusedRoutes, RoundTrip, RouteLabels, fuse_routes, fuse_routes_with, parts_route,
+};
 use rand::{RngExt, SeedableRng};
 
 /// Route labels on shape 1 of two (shape 0 a source): `labels` with confidence `conf`.
@@ -61,7 +63,7 @@ fn fuse_with(
 ) -> FusedRoutes {
     let refs: Vec<&RouteLabels> = routes.iter().collect();
     let areas: Vec<&[f64]> = areas.iter().map(Vec::as_slice).collect();
-    fuse_routes_with(&refs, &areas, held_out, shared)
+    fuse_routes_with(&refs, &areas, held_out, shared, None)
 }
 
 fn accuracy(a: &[i32], b: &[i32]) -> f64 {
@@ -340,6 +342,64 @@ fn a_pair_that_fails_independently_is_fused_as_before() {
     let fused = fuse_with(&routes, &areas, None, Some((0, 1)));
     let acc = accuracy(&fused.labels[1], &truth);
     assert!(acc > 0.99, "fused accuracy {acc}");
+}
+
+#[test]
+fn a_round_trip_on_the_source_keeps_a_pair_failing_together_from_outvoting_the_third_route() {
+    // The mirror-confused routes, with parts not read as intrinsic (no shared-failure vote):
+    // the affinity and the parts agree on a wrong label on a quarter of the shape, so the
+    // triangles credit them and discredit the rigid route. The parts route's accuracy
+    // measured by its round trip on the source sets its level; the rigid route is read off
+    // its agreement with the parts and the affinity off its agreement with the rigid route,
+    // and the pair's agreement, which their joint failures inflate, is not read.
+    let (truth, routes, areas) = mirror_confused(6000);
+    let one_coin = fuse(&routes, &areas);
+    let parts = accuracy(&routes[1].labels[1], &truth);
+    let trip = RoundTrip {
+        route: 1,
+        partner: 0,
+        accuracy: parts,
+    };
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let a: Vec<&[f64]> = areas.iter().map(Vec::as_slice).collect();
+    let fused = fuse_routes_with(&refs, &a, None, None, Some(trip));
+    let (acc, before) = (
+        accuracy(&fused.labels[1], &truth),
+        accuracy(&one_coin.labels[1], &truth),
+    );
+    let rigid = accuracy(&routes[2].labels[1], &truth);
+    assert!(acc > before + 0.05, "round trip {acc}, triangles {before}");
+    assert!(acc > rigid - 0.01, "round trip {acc}, rigid {rigid}");
+    let w = &fused.weights[1];
+    assert!(w[2] > w[0] && w[2] > w[1], "weights {w:?}");
+    // Deterministic; and with held-out accuracies (several sources) those set the levels.
+    assert_eq!(fused, fuse_routes_with(&refs, &a, None, None, Some(trip)));
+    assert_eq!(
+        fuse_routes_with(&refs, &a, Some(&[0.65, 0.65, 0.92]), None, Some(trip)),
+        fuse_routes_with(&refs, &a, Some(&[0.65, 0.65, 0.92]), None, None)
+    );
+}
+
+#[test]
+fn a_round_trip_at_chance_or_on_other_routes_changes_nothing() {
+    // A measured accuracy at chance says nothing of the others' levels, and a round trip
+    // naming routes that do not vote on a shape leaves its triangles alone.
+    let (_, routes, areas) = mirror_confused(3000);
+    let refs: Vec<&RouteLabels> = routes.iter().collect();
+    let a: Vec<&[f64]> = areas.iter().map(Vec::as_slice).collect();
+    let plain = fuse_routes_with(&refs, &a, None, None, None);
+    let chance = RoundTrip {
+        route: 1,
+        partner: 0,
+        accuracy: 1.0 / 6.0,
+    };
+    assert_eq!(fuse_routes_with(&refs, &a, None, None, Some(chance)), plain);
+    let absent = RoundTrip {
+        route: 5,
+        partner: 0,
+        accuracy: 0.9,
+    };
+    assert_eq!(fuse_routes_with(&refs, &a, None, None, Some(absent)), plain);
 }
 
 #[test]

@@ -1,10 +1,11 @@
 //! [`fuse_propagation`]: the default propagation — every correspondence route, one answer.
 
 use super::held_out::{HeldOutInputs, held_out_routes_cached};
+use super::parts_route::parts_round_trip;
 use super::rigid_route::{RigidSteps, rigid_route_weighed};
 use super::{
     ClassifierReport, FusedRoutes, HeldOutRoutes, PropagateError, PropagateOptions, Propagation,
-    Route, RouteLabels, classifier_route, fuse_routes_with, parts_route, snap_labels,
+    RoundTrip, Route, RouteLabels, classifier_route, fuse_routes_with, parts_route, snap_labels,
 };
 use crate::graph::{Cosegmentation, GraphError, GraphOptions, ShapeGraph, ShapeNode};
 use crate::mesh::TriMesh;
@@ -65,6 +66,15 @@ pub struct RouteOptions {
     /// +0.9 per family) but it costs the shipped chairs 1.6 points (a chair's seat and back
     /// share bands of the intrinsic features; docs/PROPAGATION.md, "Measured: the classifier").
     pub classifier: bool,
+    /// Whether the fusion from one source reads the parts route's round trip on the source
+    /// (its labels carried to its own parts and back) as a ceiling on the parts route's
+    /// accuracy, and where a shape's agreement triangle credits the parts above it, reads the
+    /// rigid route off its agreement with the parts and the affinity off its agreement with
+    /// the rigid route ([`super::RoundTrip`]). Default `false`: TOSCA wolf +8.8 points, the
+    /// man-made sets measured −0.1 to +0.5 (docs/PROPAGATION.md, "the parts route's round
+    /// trip"). Options saved without it read as `false`.
+    #[serde(default)]
+    pub round_trip: bool,
 }
 
 impl Default for RouteOptions {
@@ -77,6 +87,7 @@ impl Default for RouteOptions {
             nonrigid: true,
             map: true,
             classifier: false,
+            round_trip: false,
         }
     }
 }
@@ -93,6 +104,7 @@ impl RouteOptions {
             nonrigid: false,
             map: false,
             classifier: false,
+            round_trip: false,
         }
     }
 
@@ -424,6 +436,7 @@ pub fn fuse_propagation(
     report.routes.push((Route::Affinity, affinity));
     let mut segmentation = None;
     let mut parts_intrinsic = false;
+    let mut parts_trip = None;
     if let (true, Some(parts)) = (options.parts, parts) {
         let count = propagation.parts.len();
         let _t = crate::stage_timer::stage("parts route (co-segmentation)");
@@ -437,6 +450,7 @@ pub fn fuse_propagation(
                 report
                     .routes
                     .push((Route::Parts, parts_route(seg, annotations, &areas)));
+                parts_trip = parts_round_trip(seg, annotations, &areas);
                 segmentation = Some(seg);
             }
             Err(e) => report
@@ -506,7 +520,29 @@ pub fn fuse_propagation(
         .position(|&r| r == Route::Affinity)
         .zip(names.iter().position(|&r| r == Route::Parts))
         .filter(|_| parts_intrinsic);
-    report.fused = fuse_routes_with(&refs, &areas, report.held_out.as_deref(), shared);
+    // The parts route's round trip on the sources measures its accuracy; the band affinity
+    // reads the same band features, so it is the partner whose agreement with the parts is
+    // not read (`fuse_routes_with`).
+    let position = |route: Route| names.iter().position(|&r| r == route);
+    let round_trip = match (
+        position(Route::Parts),
+        position(Route::Affinity),
+        parts_trip,
+    ) {
+        (Some(route), Some(partner), Some(accuracy)) if options.round_trip => Some(RoundTrip {
+            route,
+            partner,
+            accuracy,
+        }),
+        _ => None,
+    };
+    report.fused = fuse_routes_with(
+        &refs,
+        &areas,
+        report.held_out.as_deref(),
+        shared,
+        round_trip,
+    );
     if options.classifier {
         let _t = crate::stage_timer::stage("classifier");
         report.classifier = Some(classifier_route(

@@ -81,6 +81,20 @@ pub struct FusedRoutes {
     pub agreement: Vec<Vec<f64>>,
 }
 
+/// A route whose accuracy the sources measure by a round trip (their labels carried to
+/// themselves through it: the parts route, [`super::parts_route`]), and the route that may
+/// fail together with it. See [`fuse_routes_with`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RoundTrip {
+    /// The route measured (an index into the `routes` of [`fuse_routes_with`]).
+    pub route: usize,
+    /// The route that reads the same evidence and may share its failures (the band affinity
+    /// for the parts route: both read the band features).
+    pub partner: usize,
+    /// The measured accuracy: the area share of the sources' labels the round trip gives back.
+    pub accuracy: f64,
+}
+
 /// One shape's voting routes, its number of labels and each voting route's κ estimate.
 type ShapeVotes = (Vec<usize>, usize, Vec<f64>);
 
@@ -123,10 +137,10 @@ const MAX_KAPPA: f64 = 0.99;
 /// lowers the estimate of a third: [`fuse_routes_with`] takes such a pair, or the routes'
 /// accuracies measured on the sources.
 pub fn fuse_routes(routes: &[&RouteLabels], areas: &[&[f64]]) -> FusedRoutes {
-    fuse_routes_with(routes, areas, None, None)
+    fuse_routes_with(routes, areas, None, None, None)
 }
 
-/// [`fuse_routes`] with two kinds of evidence the agreement triangles lack; `None` for both
+/// [`fuse_routes`] with three kinds of evidence the agreement triangles lack; `None` for all
 /// is [`fuse_routes`].
 ///
 /// `shared`: two routes (indices into `routes`) that may fail together, as the band affinity
@@ -148,11 +162,25 @@ pub fn fuse_routes(routes: &[&RouteLabels], areas: &[&[f64]]) -> FusedRoutes {
 /// against the user's own labels, so it sets the level: each route's per-shape κ is scaled so
 /// that its mean over the shapes is the held-out κ (with fewer than three routes voting,
 /// where no triangle exists, the held-out κ itself).
+///
+/// `round_trip` (used where no `held_out` is given, on the shapes where exactly three routes
+/// vote, the measured route, its partner and one more): one route's accuracy measured on the
+/// sources by a round trip ([`RoundTrip`]; the parts route with one source). A triangle reads
+/// each route's accuracy off all three agreements, so a pair that fails together (the band
+/// affinity and the parts, which read the same band features) inflates itself and deflates
+/// the third route, and the shape's agreements cannot say which pair did it. With one
+/// route's accuracy `κ_m` measured, the agreements that pair can bias are not needed: the
+/// third route is read off its agreement with the measured one, `κ_z = κ_mz / κ_m`, and the
+/// partner off its agreement with the third route, `κ_p = κ_pz / κ_z` (the partner's own
+/// triangle where the third route agrees with nothing); the partner's agreement with the
+/// measured route is not read. Where the shared-failure vote or a collapse reading takes a
+/// shape (below), it still does.
 pub fn fuse_routes_with(
     routes: &[&RouteLabels],
     areas: &[&[f64]],
     held_out: Option<&[f64]>,
     shared: Option<(usize, usize)>,
+    round_trip: Option<RoundTrip>,
 ) -> FusedRoutes {
     let n = areas.len();
     let nr = routes.len();
@@ -177,7 +205,12 @@ pub fn fuse_routes_with(
         values.sort_unstable();
         values.dedup();
         let matrix = pair_kappa(routes, &voting, i, a);
-        let kappas = route_kappas(&matrix);
+        let mut kappas = route_kappas(&matrix);
+        if let (None, Some(rt)) = (held_out, round_trip) {
+            if let Some(k) = anchored_kappas(&matrix, &voting, &kappas, values.len(), rt) {
+                kappas = k;
+            }
+        }
         shapes[i] = Some((voting, values.len(), kappas));
         matrices[i] = matrix;
     }
@@ -413,6 +446,51 @@ fn route_kappas(kappa: &[Vec<f64>]) -> Vec<f64> {
             k.clamp(0.0, MAX_KAPPA)
         })
         .collect()
+}
+
+/// Each voting route's accuracy above chance on a shape of three voting routes with the
+/// pairwise κ `kappa` (voting positions), read from the round trip's measured route
+/// ([`RoundTrip`]; see [`fuse_routes_with`]): the measured route at its measured κ, the third
+/// route off its agreement with it, the partner off its agreement with the third route
+/// (its triangle value in `triangle` where the third route agrees with nothing). `None` where
+/// the three are not the measured route, its partner and one more, or the measured accuracy is
+/// not above chance among `labels` labels.
+fn anchored_kappas(
+    kappa: &[Vec<f64>],
+    voting: &[usize],
+    triangle: &[f64],
+    labels: usize,
+    rt: RoundTrip,
+) -> Option<Vec<f64>> {
+    if voting.len() != 3 || triangle.len() != 3 {
+        return None;
+    }
+    let m = voting.iter().position(|&r| r == rt.route)?;
+    let p = voting.iter().position(|&r| r == rt.partner)?;
+    if m == p {
+        return None;
+    }
+    let z = 3 - m - p;
+    let l = labels.max(2) as f64;
+    let km = ((rt.accuracy - 1.0 / l) / (1.0 - 1.0 / l)).min(MAX_KAPPA);
+    // Read as a ceiling, not a level: targets lacking a part the source has make the round
+    // trip overstate the route (COSEG chairs: the parts give their sources back 83–100 %, the
+    // other chairs 64–91 %), so it is used only where the shape's triangle credits the route
+    // above it, where the triangle has counted shared failures as agreement.
+    if !(km > 0.0 && triangle[m] > km) {
+        return None;
+    }
+    let kz = (kappa[m][z].max(0.0) / km).min(MAX_KAPPA);
+    let kp = if kz > 0.0 {
+        (kappa[p][z].max(0.0) / kz).min(MAX_KAPPA)
+    } else {
+        triangle[p]
+    };
+    let mut out = vec![0.0; 3];
+    out[m] = km;
+    out[z] = kz;
+    out[p] = kp;
+    Some(out)
 }
 
 /// The log-odds vote weight `ln(p (L − 1) / (1 − p))` of a route right above chance by `κ`

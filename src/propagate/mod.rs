@@ -43,7 +43,7 @@ pub use collection::{
     propagate_collection, propagate_loaded,
 };
 pub use fuse_propagation::{CollectionParts, FusionReport, RouteOptions, fuse_propagation};
-pub use fuse_routes::{FusedRoutes, Route, RouteLabels, fuse_routes, fuse_routes_with};
+pub use fuse_routes::{FusedRoutes, RoundTrip, Route, RouteLabels, fuse_routes, fuse_routes_with};
 pub use held_out::{HeldOutInputs, HeldOutRoutes, held_out_accuracy, held_out_routes};
 pub use map_route::{fuse_with_map, map_route, map_route_on};
 pub use map_step::{MapStepOptions, MapStepReport, map_step};

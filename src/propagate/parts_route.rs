@@ -35,33 +35,8 @@ pub fn parts_route(
     areas: &[&[f64]],
 ) -> RouteLabels {
     let n = annotations.len();
-    let tuples = segmentation.tuples.len();
     let region_of: Vec<Vec<i32>> = (0..n).map(|i| segmentation.labels(i)).collect();
-    // Area of each label inside each tuple, summed over the sources.
-    let mut tally: Vec<std::collections::BTreeMap<i32, f64>> = vec![Default::default(); tuples];
-    for (i, ann) in annotations.iter().enumerate() {
-        let Some(ann) = ann else { continue };
-        for (v, (&l, &r)) in ann.iter().zip(&region_of[i]).enumerate() {
-            if l >= 0 && r >= 0 {
-                *tally[r as usize].entry(l).or_insert(0.0) += areas[i][v];
-            }
-        }
-    }
-    let names: Vec<(i32, f64)> = tally
-        .iter()
-        .map(|t| {
-            let total: f64 = t.values().sum();
-            // Ties: the smallest label (BTreeMap order), so the result is deterministic.
-            let best = t.iter().fold(None::<(i32, f64)>, |b, (&l, &a)| match b {
-                Some((_, ba)) if ba >= a => b,
-                _ => Some((l, a)),
-            });
-            match best {
-                Some((l, a)) if total > 0.0 => (l, a / total),
-                _ => (-1, 0.0),
-            }
-        })
-        .collect();
+    let names = part_names(segmentation.tuples.len(), &region_of, annotations, areas);
     let mut out = RouteLabels::empty(n);
     for i in 0..n {
         if annotations[i].is_some() {
@@ -81,4 +56,70 @@ pub fn parts_route(
         out.confidence[i] = conf;
     }
     out
+}
+
+/// The parts route's accuracy on the sources themselves: their labels carried to their own
+/// parts and back (each part named as [`parts_route`] names it, each source vertex given its
+/// part's name), the area share of the annotated source area that gets its own label back;
+/// `None` without annotated area in a part.
+///
+/// A round trip, measured against labels the user gave: where the co-segmentation's parts
+/// straddle the labelled parts, no naming of them can give the sources their labels back,
+/// and the route cannot do better on the other shapes than the parts allow on the sources.
+pub(crate) fn parts_round_trip(
+    segmentation: &Cosegmentation,
+    annotations: &[Option<Vec<i32>>],
+    areas: &[&[f64]],
+) -> Option<f64> {
+    let n = annotations.len();
+    let region_of: Vec<Vec<i32>> = (0..n).map(|i| segmentation.labels(i)).collect();
+    let names = part_names(segmentation.tuples.len(), &region_of, annotations, areas);
+    let (mut right, mut total) = (0.0, 0.0);
+    for (i, ann) in annotations.iter().enumerate() {
+        let Some(ann) = ann else { continue };
+        for (v, (&l, &r)) in ann.iter().zip(&region_of[i]).enumerate() {
+            if l >= 0 && r >= 0 {
+                total += areas[i][v];
+                if names[r as usize].0 == l {
+                    right += areas[i][v];
+                }
+            }
+        }
+    }
+    (total > 0.0).then(|| right / total)
+}
+
+/// Each part's name (the area-weighted majority of the annotated labels it covers on the
+/// sources, ties to the smallest label; `-1` where it covers none) and purity.
+fn part_names(
+    tuples: usize,
+    region_of: &[Vec<i32>],
+    annotations: &[Option<Vec<i32>>],
+    areas: &[&[f64]],
+) -> Vec<(i32, f64)> {
+    // Area of each label inside each tuple, summed over the sources.
+    let mut tally: Vec<std::collections::BTreeMap<i32, f64>> = vec![Default::default(); tuples];
+    for (i, ann) in annotations.iter().enumerate() {
+        let Some(ann) = ann else { continue };
+        for (v, (&l, &r)) in ann.iter().zip(&region_of[i]).enumerate() {
+            if l >= 0 && r >= 0 {
+                *tally[r as usize].entry(l).or_insert(0.0) += areas[i][v];
+            }
+        }
+    }
+    tally
+        .iter()
+        .map(|t| {
+            let total: f64 = t.values().sum();
+            // Ties: the smallest label (BTreeMap order), so the result is deterministic.
+            let best = t.iter().fold(None::<(i32, f64)>, |b, (&l, &a)| match b {
+                Some((_, ba)) if ba >= a => b,
+                _ => Some((l, a)),
+            });
+            match best {
+                Some((l, a)) if total > 0.0 => (l, a / total),
+                _ => (-1, 0.0),
+            }
+        })
+        .collect()
 }
