@@ -206,10 +206,10 @@ pub fn fuse_routes_with(
         values.dedup();
         let matrix = pair_kappa(routes, &voting, i, a);
         let mut kappas = route_kappas(&matrix);
-        if let (None, Some(rt)) = (held_out, round_trip) {
-            if let Some(k) = anchored_kappas(&matrix, &voting, &kappas, values.len(), rt) {
-                kappas = k;
-            }
+        if let (None, Some(rt)) = (held_out, round_trip)
+            && let Some(k) = anchored_kappas(&matrix, &voting, &kappas, values.len(), rt)
+        {
+            kappas = k;
         }
         shapes[i] = Some((voting, values.len(), kappas));
         matrices[i] = matrix;
