@@ -12,6 +12,20 @@ fn step(x: f64, a: f64, w: f64) -> f64 {
     t * t * (3.0 - 2.0 * t)
 }
 
+/// The side of a tube of `along` rings of `around` vertices each (ring `i`'s vertex `j` at
+/// index `i · around + j`): two triangles per quad, wound the same way round.
+fn ring_faces(along: usize, around: usize) -> Vec<[u32; 3]> {
+    let id = |i: usize, j: usize| (i * around + j % around) as u32;
+    let mut faces = Vec::new();
+    for i in 0..along - 1 {
+        for j in 0..around {
+            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+            faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+        }
+    }
+    faces
+}
+
 /// A closed-ended tube along x: a head of radius 1 on `[0, 1]`, a neck of radius 0.3 up to
 /// `neck_end`, a second head of radius 0.7 up to `neck_end + 1` (the heads differ, so the
 /// shape has one orientation). Per vertex the part it belongs to (0 head, 1 neck, 2 other
@@ -41,14 +55,8 @@ fn dumbbell(neck_end: f64, along: usize, around: usize) -> (TriMesh, Vec<i32>) {
             });
         }
     }
-    let mut faces = Vec::new();
+    let mut faces = ring_faces(along, around);
     let id = |i: usize, j: usize| (i * around + j % around) as u32;
-    for i in 0..along - 1 {
-        for j in 0..around {
-            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
     // Caps: a centre vertex at each end.
     for (i, x, l) in [(0usize, 0.0, 0), (along - 1, length, 2)] {
         let c = positions.len() as u32;
@@ -105,14 +113,7 @@ fn bent_tube(bend: f64, along: usize, around: usize) -> (TriMesh, Vec<i32>) {
             labels.push(i32::from(s >= 2.0));
         }
     }
-    let mut faces = Vec::new();
-    let id = |i: usize, j: usize| (i * around + j % around) as u32;
-    for i in 0..along - 1 {
-        for j in 0..around {
-            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
-            faces.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
+    let faces = ring_faces(along, around);
     (TriMesh::new(positions, faces).unwrap(), labels)
 }
 
