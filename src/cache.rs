@@ -29,6 +29,9 @@
 //! | `<key>.coseg-bands` ([`EntryKind::Bands`]) | [`crate::pipeline::ShapeBands`] | band table (u8, `d × N`), vertex areas (f64), the whole payload deflated | about `d·N / 6 + 8·d` (10k: 0.5 MB) |
 //! | `<key>.coseg-cues` ([`EntryKind::PartCues`], only with `--parts-from geometry`; key: the mesh and the SDF options, not the feature options) | [`crate::parts::PartCues`] | thickness and mean curvature (f64) | `16·d` (10k: 0.16 MB) |
 //! | `<key>.coseg-tree` ([`EntryKind::PartTree`], one per collection, with parts from geometry; key: [`crate::parts::part_tree_key`]) | the part tree of [`crate::parts::segment_collection_cached`] (`coseg segment`, and the parts route of `coseg propagate`, which reads the same entry) | the leaves' vertex lists (u32), the tree, the feature choice, the extrinsic band tables when chosen (u8), the whole payload deflated | about `4·Σd` + `Σd·E/6` (E extrinsic columns) |
+//! | `<key>.coseg-pair` ([`EntryKind::RigidPair`], one per (source, target) pair of `coseg propagate`'s rigid route; key: both meshes, the refinement steps, the start rotation) | the registration (every candidate pose) and, per pose read, the nearest source vertex (i32) and distance (f64) of every target vertex | `12·d` per pose read (d: the target's vertices) + ~0.5 kB |
+//! | `<key>.coseg-align` ([`EntryKind::Alignment`], one per collection of `coseg propagate`; key: every mesh in order) | the collection alignment the rigid route starts from | ~0.3 kB per shape |
+//! | `<key>.coseg-map` ([`EntryKind::PointMap`], one per target and labelling of `coseg propagate`'s map route; key: both shapes' per-shape keys, the source's and the target's labels, the map options) | the point map (u32 per target vertex) | `4·d` |
 //!
 //! The descriptors (spectral and extrinsic) are not in the full entry: a warm load recomputes
 //! them from the stored spectrum with the cold run's own code
@@ -58,6 +61,12 @@ pub const BANDS_EXTENSION: &str = "coseg-bands";
 pub const CUES_EXTENSION: &str = "coseg-cues";
 /// File extension of the part-tree entries ([`EntryKind::PartTree`]).
 pub const PART_TREE_EXTENSION: &str = "coseg-tree";
+/// File extension of the rigid route's pair entries ([`EntryKind::RigidPair`]).
+pub const RIGID_PAIR_EXTENSION: &str = "coseg-pair";
+/// File extension of the collection-alignment entries ([`EntryKind::Alignment`]).
+pub const ALIGNMENT_EXTENSION: &str = "coseg-align";
+/// File extension of the map route's point-map entries ([`EntryKind::PointMap`]).
+pub const POINT_MAP_EXTENSION: &str = "coseg-map";
 /// Deflate level of compressed payloads ([`EntryKind::compressed`]).
 const DEFLATE_LEVEL: u32 = 3;
 /// Deflate's largest expansion (a run of one byte: 258 bytes per 2-bit code, about 1032:1),
@@ -79,6 +88,17 @@ pub enum EntryKind {
     /// ([`crate::parts::segment_collection_cached`]); keyed by every shape's key and the
     /// collection stage's options but the number of parts.
     PartTree,
+    /// The rigid route's registration of one (source, target) pair and the nearest source
+    /// vertex of every target vertex under the poses read (`coseg propagate`); keyed by both
+    /// meshes, the refinement steps and the registration's start.
+    RigidPair,
+    /// A collection's alignment ([`crate::align::align_collection`], default options), the
+    /// rigid route's starts; keyed by every mesh of the collection in order.
+    Alignment,
+    /// The map route's point map of one target onto its source (`coseg propagate`); keyed by
+    /// both shapes' per-shape keys, the source's annotation and the labels the map was fitted
+    /// to.
+    PointMap,
 }
 
 impl EntryKind {
@@ -89,6 +109,9 @@ impl EntryKind {
             EntryKind::Bands => b"COSEGBND",
             EntryKind::PartCues => b"COSEGCUE",
             EntryKind::PartTree => b"COSEGTRE",
+            EntryKind::RigidPair => b"COSEGPAR",
+            EntryKind::Alignment => b"COSEGALN",
+            EntryKind::PointMap => b"COSEGMAP",
         }
     }
 
@@ -99,6 +122,9 @@ impl EntryKind {
             EntryKind::Bands => BANDS_EXTENSION,
             EntryKind::PartCues => CUES_EXTENSION,
             EntryKind::PartTree => PART_TREE_EXTENSION,
+            EntryKind::RigidPair => RIGID_PAIR_EXTENSION,
+            EntryKind::Alignment => ALIGNMENT_EXTENSION,
+            EntryKind::PointMap => POINT_MAP_EXTENSION,
         }
     }
 

@@ -293,6 +293,9 @@ pub fn propagate_loaded(
     let timer = crate::stage_timer::stage("affinity route (propagate_labels)");
     let mut propagation = propagate_labels(&graph, smooth, annotations, &options.propagate)?;
     drop(timer);
+    // The rigid route's registrations, which do not depend on the labels, are kept beside
+    // the per-shape entries for the next run on the same shapes.
+    propagation.rigid.set_folder(options.cache_dir.clone());
     let fusion = fuse_propagation(
         &graph,
         meshes,

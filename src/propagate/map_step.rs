@@ -112,6 +112,19 @@ pub fn map_step(
     source_index: usize,
     options: &MapStepOptions,
 ) -> Result<(Vec<i32>, MapStepReport), MapError> {
+    map_step_with_map(source, target, target_areas, source_index, options)
+        .map(|(labels, report, _)| (labels, report))
+}
+
+/// [`map_step`], also returning the point map it fitted (one source vertex per target
+/// vertex) for the map route's cache.
+pub(crate) fn map_step_with_map(
+    source: &MapShape<'_>,
+    target: &MapShape<'_>,
+    target_areas: &[f64],
+    source_index: usize,
+    options: &MapStepOptions,
+) -> Result<(Vec<i32>, MapStepReport, Vec<u32>), MapError> {
     options.validate()?;
     if target_areas.len() != target.labels.len() {
         return Err(MapError::InvalidOption(format!(
@@ -121,11 +134,33 @@ pub fn map_step(
         )));
     }
     let map = region_point_map(source, target, &options.point_map)?;
+    let (labels, report) = map_step_through(
+        source.labels,
+        target.labels,
+        target_areas,
+        source_index,
+        &map,
+        options,
+    );
+    Ok((labels, report, map))
+}
+
+/// [`map_step`] through a point map already fitted (`map[q]`: the source vertex of target
+/// vertex `q`, as [`region_point_map`] returns it): the same labels and report. `map`,
+/// `target_labels` and `target_areas` are as long; every `map[q]` indexes `source_labels`.
+pub(crate) fn map_step_through(
+    source_labels: &[i32],
+    target_labels: &[i32],
+    target_areas: &[f64],
+    source_index: usize,
+    map: &[u32],
+    options: &MapStepOptions,
+) -> (Vec<i32>, MapStepReport) {
     let mut labels = Vec::with_capacity(map.len());
     let (mut agree, mut total) = (0.0, 0.0);
     for (q, &p) in map.iter().enumerate() {
-        let carried = source.labels[p as usize];
-        let own = target.labels[q];
+        let carried = source_labels[p as usize];
+        let own = target_labels[q];
         if carried < 0 {
             labels.push(own);
             continue;
@@ -145,8 +180,8 @@ pub fn map_step(
         applied,
     };
     if applied {
-        Ok((labels, report))
+        (labels, report)
     } else {
-        Ok((target.labels.to_vec(), report))
+        (target_labels.to_vec(), report)
     }
 }

@@ -1,17 +1,19 @@
 //! [`map_step_collection`]: the map step of every unlabelled shape of a propagated collection.
 
-use super::{MapStepOptions, MapStepReport, Propagation, map_step};
+use super::map_step::{map_step_through, map_step_with_map};
+use super::point_map_store::{point_map_key, read_point_map, write_point_map};
+use super::{MapStepOptions, MapStepReport, Propagation};
 use crate::graph::ShapeGraph;
 use crate::maps::MapShape;
 use crate::mesh::TriMesh;
-use crate::pipeline::ShapePipelineOptions;
+use crate::pipeline::{ShapePipelineOptions, shape_key};
 use rayon::prelude::*;
 use std::path::Path;
 
 /// One shape's map step: its labels and report, or why it could not run.
 type MapStepOutcome = Result<(Vec<i32>, MapStepReport), String>;
 
-/// The map step ([`map_step`]) of [`propagate_collection`] on every unlabelled shape of
+/// The map step ([`map_step`](fn@super::map_step)) of [`propagate_collection`] on every unlabelled shape of
 /// `propagation`, each mapped to its nearest source (smallest graph summary distance; ties:
 /// the first), in parallel (one target's full per-shape data in memory per thread, the
 /// sources' shared). The shapes' spectra come from `cache` under `pipeline`
@@ -84,10 +86,52 @@ pub(crate) fn map_step_collection_with(
     let n = meshes.len();
     let name = |i: usize| graph.node(i).name.clone();
     let sources: Vec<usize> = (0..n).filter(|&i| annotations[i].is_some()).collect();
-    let source_data: Vec<_> = sources
-        .par_iter()
-        .map(|&s| shape_data(&meshes[s]))
+    // The nearest source by summary distance (ties: the first), as an index into `sources`.
+    let nearest = |i: usize| {
+        (0..sources.len())
+            .min_by(|&a, &b| {
+                graph
+                    .summary_distance(i, sources[a])
+                    .total_cmp(&graph.summary_distance(i, sources[b]))
+            })
+            .expect("at least one source")
+    };
+    let source_labels = |k: usize| annotations[sources[k]].as_deref().unwrap_or_default();
+    // Per target, where its map is kept in the cache folder ([`point_map_key`]).
+    let entry = |i: usize, k: usize| {
+        cache.map(|c| {
+            let key = point_map_key(
+                &shape_key(&meshes[sources[k]], pipeline),
+                &shape_key(&meshes[i], pipeline),
+                source_labels(k),
+                &propagation.labels[i],
+                options,
+            );
+            (c, key)
+        })
+    };
+    // Maps fitted by an earlier run to the same shapes and labels: read, not fitted again
+    // (nor the shapes' spectra loaded for them).
+    let stored: Vec<Option<Vec<u32>>> = (0..n)
+        .into_par_iter()
+        .map(|i| {
+            if !wanted(i) {
+                return None;
+            }
+            let k = nearest(i);
+            let (c, key) = entry(i, k)?;
+            let (s, t) = (meshes[sources[k]].vertex_count(), meshes[i].vertex_count());
+            read_point_map(c, &key, s, t)
+        })
         .collect();
+    let missing = (0..n).any(|i| wanted(i) && stored[i].is_none());
+    let source_data: Vec<_> = match missing {
+        true => sources
+            .par_iter()
+            .map(|&s| shape_data(&meshes[s]))
+            .collect(),
+        false => Vec::new(),
+    };
     let mut warnings = Vec::new();
     let mut loaded = Vec::with_capacity(sources.len());
     for (&s, d) in sources.iter().zip(source_data) {
@@ -105,21 +149,26 @@ pub(crate) fn map_step_collection_with(
             if !wanted(i) {
                 return None;
             }
-            // The nearest source by summary distance (ties: the first).
-            let k = (0..sources.len())
-                .min_by(|&a, &b| {
-                    graph
-                        .summary_distance(i, sources[a])
-                        .total_cmp(&graph.summary_distance(i, sources[b]))
-                })
-                .expect("at least one source");
+            let k = nearest(i);
             let s = sources[k];
+            if let Some(map) = &stored[i] {
+                let areas = &graph.node(i).areas;
+                let (labels, report) = map_step_through(
+                    source_labels(k),
+                    &propagation.labels[i],
+                    areas,
+                    s,
+                    map,
+                    options,
+                );
+                return Some(Ok((labels, report)));
+            }
             let run = || -> MapStepOutcome {
                 let data = shape_data(&meshes[i]).map_err(|e| e.to_string())?;
                 let source = MapShape {
                     spectrum: &loaded[k].spectrum,
                     positions: meshes[s].positions(),
-                    labels: annotations[s].as_deref().unwrap_or_default(),
+                    labels: source_labels(k),
                     descriptors: None,
                 };
                 let target = MapShape {
@@ -128,8 +177,14 @@ pub(crate) fn map_step_collection_with(
                     labels: &propagation.labels[i],
                     descriptors: None,
                 };
-                map_step(&source, &target, &graph.node(i).areas, s, options)
-                    .map_err(|e| e.to_string())
+                let (labels, report, map) =
+                    map_step_with_map(&source, &target, &graph.node(i).areas, s, options)
+                        .map_err(|e| e.to_string())?;
+                if let Some((c, key)) = entry(i, k) {
+                    // Not written: the next run fits the map again, with the same result.
+                    let _ = write_point_map(c, &key, &map);
+                }
+                Ok((labels, report))
             };
             Some(run())
         })

@@ -5,15 +5,21 @@ use super::RouteLabels;
 use super::fuse_routes::cohen_kappa;
 use super::refine_affine::{AffineMap, refine_affine_reading};
 use super::refine_nonrigid::refine_nonrigid_reading;
+use super::rigid_pair_store::{
+    StoredPair, alignment_key, read_alignment, read_pair, rigid_pair_key, shape_hash,
+    write_alignment, write_pair,
+};
 use crate::align::{
     AlignError, AlignOptions, Candidate, CollectionAlignment, FrameCase, Prepared, RegisterOptions,
     Registration, Similarity, SurfaceIndex, align_collection, nearest_corner,
     nearest_point_vertex_labels_in, register_onto_from,
 };
+use crate::cache::ShapeKey;
 use crate::mesh::TriMesh;
 use nalgebra::Matrix3;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::path::PathBuf;
 use std::sync::{Arc, Mutex};
 
 /// The rigid route of the fused propagation: every unlabelled shape is registered onto each
@@ -92,6 +98,10 @@ struct PairFit {
     /// Per candidate pose of the registration (its index in [`Registration::candidates`]): the
     /// source vertex of every target vertex; made on the first call that reads this pose.
     nearest: BTreeMap<usize, Nearest>,
+    /// The pair's entry on disk ([`super::rigid_pair_store`]), when the cache has a folder.
+    disk: Option<ShapeKey>,
+    /// Whether this holds something its entry on disk does not.
+    dirty: bool,
 }
 
 /// Per target vertex the source vertex it reads and its distance to the source's surface, and
@@ -105,9 +115,16 @@ type Nearest = (Vec<i32>, Vec<f64>, f64);
 /// empty cache, bit for bit: what is kept is exactly what would be recomputed.
 ///
 /// Entries are keyed by the shapes' indices and vertex counts and the refinement steps; a cache
-/// serves one collection of meshes (a [`super::Propagation`] keeps one for its graph).
+/// serves one collection of meshes (a [`super::Propagation`] keeps one for its graph). With a
+/// folder ([`RigidCache::set_folder`]) the pairs and the collection alignment are also kept on
+/// disk ([`super::rigid_pair_store`], keyed by the meshes' contents), so that another run on
+/// the same shapes reads them.
 #[derive(Debug, Default)]
 pub(crate) struct RigidCache {
+    /// The cache folder of the disk entries (`None`: memory only).
+    folder: Option<PathBuf>,
+    /// Per shape (index, vertex count): its content hash, the disk entries' key.
+    hashes: Mutex<BTreeMap<(usize, usize), [u8; 32]>>,
     pairs: Mutex<BTreeMap<PairKey, PairFit>>,
     /// Per source (index, vertex count): its registration samples and surface index, made
     /// once for all the targets read from it (a few sources, every target: the same work
@@ -149,6 +166,13 @@ type PairKey = (usize, usize, usize, usize, RigidSteps);
 impl Clone for RigidCache {
     fn clone(&self) -> Self {
         RigidCache {
+            folder: self.folder.clone(),
+            hashes: Mutex::new(
+                self.hashes
+                    .lock()
+                    .unwrap_or_else(|e| e.into_inner())
+                    .clone(),
+            ),
             pairs: Mutex::new(self.lock().clone()),
             sources: Mutex::new(self.lock_sources().clone()),
             frames: Mutex::new(self.lock_frames().clone()),
@@ -165,6 +189,33 @@ impl PartialEq for RigidCache {
 }
 
 impl RigidCache {
+    /// Keeps the pairs and the collection alignment in `folder` too (`None`: in memory only).
+    pub(crate) fn set_folder(&mut self, folder: Option<PathBuf>) {
+        self.folder = folder;
+    }
+
+    /// The content hash of shape `i` (made once).
+    fn hash(&self, meshes: &[TriMesh], i: usize) -> [u8; 32] {
+        let key = (i, meshes[i].vertex_count());
+        let mut hashes = self.hashes.lock().unwrap_or_else(|e| e.into_inner());
+        *hashes.entry(key).or_insert_with(|| shape_hash(&meshes[i]))
+    }
+
+    /// Writes every pair that holds something its disk entry does not. A pair that cannot be
+    /// written is left for the next run to make again: no result depends on the disk.
+    fn store(&self) {
+        let Some(folder) = &self.folder else { return };
+        let mut pairs = self.lock();
+        for fit in pairs.values_mut().filter(|f| f.dirty) {
+            if let Some(key) = &fit.disk {
+                let stored =
+                    StoredPair::new(&fit.registration, fit.nearest.iter().map(|(k, n)| (*k, n)));
+                let _ = write_pair(folder, key, &stored);
+            }
+            fit.dirty = false;
+        }
+    }
+
     fn lock(&self) -> std::sync::MutexGuard<'_, BTreeMap<PairKey, PairFit>> {
         // A panic elsewhere cannot leave an entry half written (entries are inserted whole).
         self.pairs.lock().unwrap_or_else(|e| e.into_inner())
@@ -204,7 +255,7 @@ impl RigidCache {
             return f.alignment.clone();
         }
         let matrix = |r: &[[f64; 3]; 3]| Matrix3::from_fn(|i, j| r[i][j]);
-        let alignment = Arc::new(align_collection(meshes, &AlignOptions::default()));
+        let alignment = Arc::new(self.align(meshes));
         let rotations = alignment.as_ref().as_ref().ok().map(|a| {
             a.shapes
                 .iter()
@@ -221,6 +272,25 @@ impl RigidCache {
             rotations,
         }));
         alignment
+    }
+
+    /// [`align_collection`] of `meshes` (default options), read from the cache folder when it
+    /// holds it and written there when made.
+    fn align(&self, meshes: &[TriMesh]) -> Result<CollectionAlignment, AlignError> {
+        let Some(folder) = &self.folder else {
+            return align_collection(meshes, &AlignOptions::default());
+        };
+        let hashes: Vec<[u8; 32]> = (0..meshes.len()).map(|i| self.hash(meshes, i)).collect();
+        let key = alignment_key(&hashes);
+        if let Some(a) = read_alignment(folder, &key, meshes.len()) {
+            return Ok(a);
+        }
+        let made = align_collection(meshes, &AlignOptions::default());
+        if let Ok(a) = &made {
+            // Not written: the next run aligns again, with the same result.
+            let _ = write_alignment(folder, &key, a);
+        }
+        made
     }
 
     /// The first start of the registration of target `i` onto source `s`: the collection
@@ -283,6 +353,36 @@ impl RigidCache {
         // `register_pair(source, target)` with the source prepared once, started from the
         // collection frame.
         let start = self.start(meshes, s, i);
+        let disk = self.folder.as_ref().map(|folder| {
+            let rows = std::array::from_fn(|r| std::array::from_fn(|c| start[(r, c)]));
+            let (hs, hi) = (self.hash(meshes, s), self.hash(meshes, i));
+            let steps_bits = [steps.affine, steps.nonrigid];
+            (
+                folder,
+                rigid_pair_key(&hs, &hi, steps_bits, &rows, AFFINE_TRIM),
+            )
+        });
+        if let Some((folder, k)) = &disk
+            && let Some(stored) = read_pair(
+                folder,
+                k,
+                meshes[s].vertex_count(),
+                meshes[i].vertex_count(),
+            )
+        {
+            let (registration, nearest) = stored.into_parts();
+            return self
+                .lock()
+                .entry(key)
+                .or_insert(PairFit {
+                    registration,
+                    nearest: nearest.into_iter().collect(),
+                    disk: Some(*k),
+                    dirty: false,
+                })
+                .registration
+                .clone();
+        }
         let registration = match &self.source(meshes, s).prepared {
             Ok(source) => {
                 register_onto_from(source, &meshes[i], &RegisterOptions::default(), &start)
@@ -295,6 +395,8 @@ impl RigidCache {
             .or_insert(PairFit {
                 registration,
                 nearest: BTreeMap::new(),
+                disk: disk.map(|(_, k)| k),
+                dirty: true,
             })
             .registration
             .clone()
@@ -377,6 +479,7 @@ impl RigidCache {
         .map_err(|e| e.to_string())?;
         if let Some(f) = self.lock().get_mut(&key) {
             f.nearest.insert(index_of_pose, carried.clone());
+            f.dirty = true;
         }
         Ok(carried)
     }
@@ -584,6 +687,7 @@ pub(crate) fn rigid_alternatives_cached(
             Some(Ok(out))
         })
         .collect();
+    cache.store();
     let mut out = vec![Vec::new(); n];
     let mut warnings = Vec::new();
     for (i, r) in results.into_iter().enumerate() {
