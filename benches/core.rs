@@ -3,7 +3,8 @@
 //! band-affinity product `W·x` at several sizes and feature counts, Algorithms 1, 2 and 3, the
 //! stable cycle over 3 shapes, the co-segmentation sweep of a generated collection, the
 //! spectrum, the descriptors (HKS, WKS, curvature), ZoomOut, the clustered candidate search of
-//! the last match and its auction.
+//! the last match and its auction, and a warm `coseg propagate` (every route, the cache filled
+//! by a first run).
 //!
 //! ```text
 //! cargo bench --bench core            # all, ~3 min
@@ -15,6 +16,7 @@ use coseg::bands::{BandTable, synthetic_band_table};
 use coseg::features::{DescriptorOptions, descriptors};
 use coseg::generate::{
     Family, GenerateOptions, SplitMix64, generate_family, grid_mesh, smooth_features,
+    write_collection,
 };
 use coseg::graph::{
     CosegmentOptions, CycleShape, CycleStep, GraphOptions, ShapeGraph, ShapeNode,
@@ -25,6 +27,7 @@ use coseg::maps::{
     nearest_candidates, zoomout,
 };
 use coseg::pipeline::{ShapePipelineOptions, compute_shape_data};
+use coseg::propagate::{PropagateCollectionOptions, propagate_collection};
 use coseg::spectral::{SpectrumOptions, laplace_beltrami_spectrum};
 use coseg::stable::{
     Algorithm, Remaining, StablePairOptions, StableRegionsOptions, Threshold, stable_pair,
@@ -211,6 +214,25 @@ fn spectrum_and_map(c: &mut Criterion) {
     });
 }
 
+/// Bare `propagate_collection` (every route fused) on 6 generated chairs from one labelled
+/// chair, warm: a first run outside the timing fills the cache folder (per-shape entries, the
+/// part tree, the rigid route's pairs and the map route's point maps), each timed run reads it.
+fn warm_propagate(c: &mut Criterion) {
+    let dir = tempfile::tempdir().expect("a temporary folder");
+    let mut options = GenerateOptions::default();
+    options.count = 6;
+    let collection = generate_family(Family::Chairs, &options).expect("generates");
+    let shapes = dir.path().join("chairs");
+    write_collection(&collection, &options, &shapes).expect("writes");
+    let labels = [shapes.join(format!("{}.labels.txt", collection.shapes[0].name))];
+    let mut o = PropagateCollectionOptions::default();
+    o.cache_dir = Some(dir.path().join("cache"));
+    propagate_collection(&shapes, &labels, &o).expect("cold run");
+    c.bench_function("propagate/warm_6_chairs", |b| {
+        b.iter(|| propagate_collection(&shapes, black_box(&labels), &o).expect("warm run"))
+    });
+}
+
 fn config() -> Criterion {
     Criterion::default()
         .sample_size(10)
@@ -221,6 +243,7 @@ fn config() -> Criterion {
 criterion_group! {
     name = benches;
     config = config();
-    targets = affinity, pair_algorithms, cosegmentation, spectrum_and_map, candidate_search
+    targets = affinity, pair_algorithms, cosegmentation, spectrum_and_map, candidate_search,
+        warm_propagate
 }
 criterion_main!(benches);
