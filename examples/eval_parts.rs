@@ -3,7 +3,7 @@
 //! ```text
 //! cargo run --release --example eval_parts -- FOLDER [--cache DIR] [--refine-rounds N]
 //!     [--features F --up AXIS [--normals N]] [--starts N] [--keep-sizes TOL] [--detail]
-//!     [--parts-from adaptive|geometry [--snap-band W]] [--all-cuts] MODE...
+//!     [--parts-from adaptive|geometry [--snap-band W]] [--all-cuts [--dump-tree FILE]] MODE...
 //! ```
 //! `--features`/`--up`/`--normals` select the feature families as `coseg segment` does (e.g.
 //! `--features spectral,extrinsic --up y --normals 16`), `--starts` its several starts, `--keep-sizes TOL`
@@ -17,7 +17,11 @@
 //! their pieces, each leaf's region of origin.
 //! `--all-cuts` (families, mode `default`): the part tree is grown once and scored at every cut
 //! from 2 to 8 parts (each cut is `coseg segment --parts N` on that tree), with its merge
-//! costs, so that rules choosing the count can be compared offline on the same trees.
+//! costs, so that rules choosing the count can be compared offline on the same trees;
+//! `--dump-tree FILE` adds the tree's merges (with the mirror pairs and copies that link
+//! leaves) and, per shape, each leaf's area share, log thickness and ground-truth composition
+//! and each pair of leaves' boundary length and concave length, as one JSON line appended to
+//! FILE (read by `scripts/count_rules.py`).
 //! `--features auto` chooses the families from the data (`coseg segment` without
 //! `--features`); the mode `default` is the bare `coseg segment` (parts from geometry, their
 //! number chosen from the part tree).
@@ -272,6 +276,9 @@ fn main() -> Res<()> {
     // cut from 2 to 8 parts, and its merge costs printed (to compare ways of choosing the
     // count on one tree).
     let mut all_cuts = false;
+    // `--dump-tree FILE` (with `--all-cuts`): the tree and its leaves per shape appended to
+    // FILE as one JSON line (`scripts/count_rules.py` reads it).
+    let mut dump_tree_to: Option<PathBuf> = None;
     let mut normals = 0;
     let mut mirrors = false;
     let mut parts_from = None;
@@ -285,6 +292,9 @@ fn main() -> Res<()> {
             "--starts" => starts = args.next().ok_or("--starts N")?.parse()?,
             "--detail" => detail = true,
             "--all-cuts" => all_cuts = true,
+            "--dump-tree" => {
+                dump_tree_to = Some(PathBuf::from(args.next().ok_or("--dump-tree FILE")?))
+            }
             "--group-mirrors" => mirrors = true,
             "--parts-from" => {
                 parts_from = Some(
@@ -364,6 +374,21 @@ fn main() -> Res<()> {
                 .map(|m| -m.similarity.clamp(f64::MIN_POSITIVE, 1.0).ln())
                 .collect();
             println!("  all-cuts costs {costs:?}");
+            if let Some(path) = &dump_tree_to {
+                let mirrors: Vec<(usize, usize)> = coseg::parts::mirror_pairs(
+                    &loaded.meshes,
+                    &stage.tree.leaves,
+                    stage.up,
+                    Some(coseg::parts::Likeness {
+                        graph: &stage.graph,
+                        columns: &stage.mirror_columns,
+                    }),
+                )
+                .iter()
+                .map(|m| (m.a, m.b))
+                .collect();
+                dump_tree(path, &folder, &loaded, &stage.tree, &cache, &mirrors)?;
+            }
             for n in 2..=8.min(stage.tree.leaves.tuples.len()) {
                 let mut on = o.clone();
                 on.request_parts(coseg::parts::PartsRequest::Count(n), None);
@@ -470,5 +495,108 @@ fn main() -> Res<()> {
             sizes.join("/")
         );
     }
+    Ok(())
+}
+
+/// Appends one JSON line describing the part tree and its leaves per shape (for offline
+/// studies of the count rule): merges, and per shape each leaf's area share, log thickness
+/// and truth composition, and each touching pair's boundary length and concave length. The
+/// thickness, the boundary (each interior edge seen from both of its faces) and the concave
+/// test are those of `parts::geometric_part_tree`, so that a rule tried on these lines
+/// reads what the tree reads.
+fn dump_tree(
+    path: &Path,
+    folder: &Path,
+    loaded: &LoadedCollection,
+    tree: &coseg::parts::AdaptiveCosegmentation,
+    cache: &Path,
+    mirrors: &[(usize, usize)],
+) -> Res<()> {
+    use std::io::Write;
+    let leaves = &tree.leaves;
+    let l = leaves.tuples.len();
+    let truth = GroundTruth::read(folder)?;
+    let mut shapes = Vec::new();
+    for (i, mesh) in loaded.meshes.iter().enumerate() {
+        let cues = coseg::parts::load_or_compute_part_cues(mesh, cache)?.cues;
+        let labels = leaves.labels(i);
+        let gt = truth.grouped_labels(&leaves.names[i])?;
+        let parts = ShapeParts::of_mesh(mesh, gt, labels.clone())?;
+        let w = mesh.vertex_areas();
+        let total: f64 = w.iter().sum();
+        let mut area = vec![0.0; l];
+        let mut lnt = vec![0.0; l];
+        for (v, &x) in labels.iter().enumerate() {
+            if x >= 0 {
+                area[x as usize] += w[v];
+                lnt[x as usize] += w[v] * cues.thickness[v].max(f64::MIN_POSITIVE).ln();
+            }
+        }
+        let nt = parts.truth.iter().copied().max().unwrap_or(0) + 1;
+        let mut comp = vec![vec![0.0; nt]; l];
+        let ptotal: f64 = parts.areas.iter().sum();
+        for ((&a, &t), &f) in parts.areas.iter().zip(&parts.truth).zip(&parts.found) {
+            if f >= 0 {
+                comp[f as usize][t] += a / ptotal;
+            }
+        }
+        let h = &cues.mean_curvature;
+        let flat = coseg::features::mean_curvature_resolution(mesh);
+        let p = mesh.positions();
+        let mut bd = std::collections::BTreeMap::new();
+        for f in mesh.faces() {
+            for k in 0..3 {
+                let (u, v) = (f[k] as usize, f[(k + 1) % 3] as usize);
+                let (x, y) = (labels[u], labels[v]);
+                if x < 0 || y < 0 || x == y {
+                    continue;
+                }
+                let d = p[u]
+                    .iter()
+                    .zip(&p[v])
+                    .map(|(a, b)| (a - b) * (a - b))
+                    .sum::<f64>()
+                    .sqrt();
+                let c = if h[u] + h[v] < -(flat[u] + flat[v]) {
+                    d
+                } else {
+                    0.0
+                };
+                let e = bd.entry((x.min(y), x.max(y))).or_insert((0.0, 0.0));
+                e.0 += d;
+                e.1 += c;
+            }
+        }
+        let bd: Vec<(i32, i32, f64, f64)> = bd
+            .into_iter()
+            .map(|((a, b), (d, c))| (a, b, d, c))
+            .collect();
+        shapes.push(serde_json::json!({
+            "area": area.iter().map(|a| a / total).collect::<Vec<_>>(),
+            "lnt": lnt.iter().zip(&area).map(|(s, a)| if *a > 0.0 { s / a } else { f64::NAN }).map(|x| if x.is_finite() { Some(x) } else { None }).collect::<Vec<_>>(),
+            "comp": comp,
+            "bd": bd,
+            "sqrt_area": total.sqrt(),
+        }));
+    }
+    let merges: Vec<(usize, usize, f64)> = tree
+        .tree
+        .merges
+        .iter()
+        .map(|m| (m.a, m.b, -m.similarity.clamp(f64::MIN_POSITIVE, 1.0).ln()))
+        .collect();
+    let line = serde_json::json!({
+        "folder": folder.display().to_string(),
+        "leaves": l,
+        "merges": merges,
+        "copies": tree.leaf_copies,
+        "mirrors": mirrors,
+        "shapes": shapes,
+    });
+    let mut f = std::fs::OpenOptions::new()
+        .create(true)
+        .append(true)
+        .open(path)?;
+    writeln!(f, "{line}")?;
     Ok(())
 }
