@@ -122,9 +122,7 @@ fn load(
         nodes.push(node);
     }
     let features = nodes.first().map_or(0, |n| n.bands.features);
-    let parts = CollectionParts::new(nodes.clone(), pipeline, graph, Some(cache.to_path_buf()));
-    let mut graph = ShapeGraph::build(nodes, graph)?;
-    graph.set_feature_weights(pipeline.feature_weights(features))?;
+    let mut parts = CollectionParts::new(nodes.clone(), pipeline, graph, Some(cache.to_path_buf()));
     let smoothers = if time > 0.0 {
         Some(
             meshes
@@ -134,6 +132,19 @@ fn load(
         )
     } else {
         None
+    };
+    // As `propagate_loaded`: the band affinity reads the families the collection chose.
+    let chosen = match routes.parts && routes.chosen_features {
+        true => parts.chosen_graph(&meshes, smoothers.as_deref())?,
+        false => None,
+    };
+    let graph = match chosen {
+        Some(g) => g,
+        None => {
+            let mut graph = ShapeGraph::build(nodes, graph)?;
+            graph.set_feature_weights(pipeline.feature_weights(features))?;
+            graph
+        }
     };
     eprintln!(
         "loaded {} shapes ({:?} graph) in {:.1} s",
@@ -699,6 +710,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             "--affine" => routes.affine = val()?.parse()?,
             "--classifier" => routes.classifier = val()?.parse()?,
             "--round-trip" => routes.round_trip = val()?.parse()?,
+            "--chosen-features" => routes.chosen_features = val()?.parse()?,
             "--nonrigid" => routes.nonrigid = val()?.parse()?,
             "--triple" => triple = Some(val()?),
             "--sources" => only = Some(val()?.split(',').map(str::to_string).collect()),

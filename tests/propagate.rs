@@ -580,3 +580,61 @@ fn coseg_propagate_map_step_on_isometric_copies() {
     assert!(without.get("map_step").is_none());
     assert!(without["shapes"][1].get("map_step").is_none());
 }
+
+/// With `RouteOptions::chosen_features` the band affinity reads the feature families the
+/// collection chose: on the shipped chairs, whose labels set the left legs apart from the
+/// right ones, the intrinsic family alone cannot tell a leg from its mirror image, while the
+/// extrinsic family in the collection frame (chosen from the data, no `--features` or `--up`
+/// given) can. The affinity route alone, from `chairs_00`, per-vertex accuracy over the five
+/// other chairs (their own eight labels): measured 0.814 with the chosen families (418
+/// columns) and 0.438 without (300), by this test in the release profile.
+#[test]
+fn affinity_route_reads_the_families_the_collection_chose() {
+    use coseg::propagate::{PropagateCollectionOptions, Route, RouteOptions, propagate_collection};
+    let dir = collections_dir().join("chairs");
+    let cache = std::env::temp_dir().join(format!("coseg-chosen-families-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&cache);
+    let affinity = |chosen: bool| {
+        let mut routes = RouteOptions::default();
+        // The affinity route is what is compared: the others are left out to keep it quick.
+        routes.rigid = false;
+        routes.map = false;
+        routes.chosen_features = chosen;
+        let mut options = PropagateCollectionOptions::default();
+        options.routes = routes;
+        options.cache_dir = Some(cache.clone());
+        let out = propagate_collection(&dir, &[dir.join("chairs_00.labels.txt")], &options)
+            .expect("propagates");
+        let features = out.graph.node(0).bands.features;
+        let (_, labels) = out
+            .fusion
+            .routes
+            .iter()
+            .find(|(r, _)| *r == Route::Affinity)
+            .expect("the affinity route");
+        let mut sum = 0.0;
+        for i in 1..6 {
+            let name = format!("chairs_0{i}");
+            let mesh = read_mesh(dir.join(format!("{name}.obj"))).unwrap();
+            let truth = read_labels(dir.join(format!("{name}.labels.txt"))).unwrap();
+            let k = (0..out.graph.node_count())
+                .find(|&k| out.graph.node(k).name == name)
+                .expect("a node per chair");
+            sum += vertex_label_agreement(&mesh, &truth, &labels.labels[k])
+                .unwrap()
+                .accuracy;
+        }
+        (features, sum / 5.0)
+    };
+    let (with_features, with) = affinity(true);
+    let (without_features, without) = affinity(false);
+    println!(
+        "affinity route from chairs_00: {with:.4} with the chosen families ({with_features} columns), {without:.4} without ({without_features})"
+    );
+    assert!(
+        with_features > without_features,
+        "the chosen families add the extrinsic columns"
+    );
+    assert!(with > without + 0.05, "{with} against {without}");
+    let _ = std::fs::remove_dir_all(&cache);
+}

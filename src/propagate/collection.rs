@@ -1,6 +1,7 @@
 //! [`propagate_collection`]: a folder of meshes and its label files in one call.
 
 use super::map_step_collection::map_step_collection;
+use super::rigid_route::RigidCache;
 use super::{
     CollectionParts, FusionReport, MapStepOptions, MapStepReport, PropagateError, PropagateOptions,
     Propagation, RouteOptions, fuse_propagation, propagate_labels,
@@ -266,11 +267,6 @@ pub fn propagate_loaded(
             options.cache_dir.clone(),
         )
     });
-    let timer = crate::stage_timer::stage("shape graph");
-    let mut graph = ShapeGraph::build(nodes, &options.graph)?;
-    drop(timer);
-    // The families' shares of the affinity (`--family-weights`), as `coseg segment` uses them.
-    graph.set_feature_weights(options.pipeline.feature_weights(features))?;
     let time = options.propagate.smoothing_time;
     let timer = crate::stage_timer::stage("heat smoothers");
     let smoothers: Vec<HeatSmoother> = if time > 0.0 {
@@ -290,12 +286,42 @@ pub fn propagate_loaded(
     };
     drop(timer);
     let smooth = (!smoothers.is_empty()).then_some(smoothers.as_slice());
+    // The rigid route's cache, made before the affinity solve so that the feature choice and
+    // the rigid route read one collection alignment; its registrations, which do not depend
+    // on the labels, are kept beside the per-shape entries for the next run on the same
+    // shapes.
+    let mut rigid = RigidCache::default();
+    rigid.set_folder(options.cache_dir.clone());
+    // With `chosen_features` the band affinity reads the families the collection chose (the
+    // extrinsic family in the collection frame on rigid-like collections: the intrinsic
+    // bands alone cannot tell a seat from a back or a left leg from its mirror image). A
+    // choice that fails leaves the pipeline's families (the parts route then reports the
+    // failure).
+    let chosen = match parts.as_mut() {
+        Some(p) if options.routes.chosen_features => {
+            let _t = crate::stage_timer::stage("parts route (co-segmentation)");
+            let alignment = || rigid.alignment(meshes);
+            p.chosen_graph_sharing(meshes, smooth, Some(&alignment))
+                .ok()
+                .flatten()
+        }
+        _ => None,
+    };
+    let graph = match chosen {
+        Some(g) => g,
+        None => {
+            let _t = crate::stage_timer::stage("shape graph");
+            let mut graph = ShapeGraph::build(nodes, &options.graph)?;
+            // The families' shares of the affinity (`--family-weights`), as `coseg segment`
+            // uses them.
+            graph.set_feature_weights(options.pipeline.feature_weights(features))?;
+            graph
+        }
+    };
     let timer = crate::stage_timer::stage("affinity route (propagate_labels)");
     let mut propagation = propagate_labels(&graph, smooth, annotations, &options.propagate)?;
+    propagation.rigid = rigid;
     drop(timer);
-    // The rigid route's registrations, which do not depend on the labels, are kept beside
-    // the per-shape entries for the next run on the same shapes.
-    propagation.rigid.set_folder(options.cache_dir.clone());
     let fusion = fuse_propagation(
         &graph,
         meshes,

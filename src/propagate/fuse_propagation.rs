@@ -75,6 +75,19 @@ pub struct RouteOptions {
     /// trip"). Options saved without it read as `false`.
     #[serde(default)]
     pub round_trip: bool,
+    /// Whether the band-affinity route reads the feature families the collection chose from
+    /// the data (the parts route's choice, [`CollectionParts::chosen_graph`]: the extrinsic
+    /// family in the collection frame added on rigid-like collections) rather than the
+    /// per-shape pipeline's intrinsic family alone. Applies with the parts route on and a
+    /// pipeline of the intrinsic family alone (families given with `--features` are read as
+    /// given). Default `false`: the affinity route itself gains 8–22 points on the shipped
+    /// families from one source, but the fusion moves −1.3 to +2.3 (quadrupeds −1.3,
+    /// goblets −0.2, humanoids +0.9, chairs +2.3): an affinity that reads the parts' own
+    /// families fails where they fail, and the fusion's one-coin model counts the two as
+    /// independent voters (docs/PROPAGATION.md, "the band affinity on the chosen families").
+    /// Options saved without it read as `false`.
+    #[serde(default)]
+    pub chosen_features: bool,
 }
 
 impl Default for RouteOptions {
@@ -88,6 +101,7 @@ impl Default for RouteOptions {
             map: true,
             classifier: false,
             round_trip: false,
+            chosen_features: false,
         }
     }
 }
@@ -105,6 +119,7 @@ impl RouteOptions {
             map: false,
             classifier: false,
             round_trip: false,
+            chosen_features: false,
         }
     }
 
@@ -159,6 +174,10 @@ struct DataParts {
     tree: Option<AdaptiveCosegmentation>,
     /// Whether the parts read the intrinsic family alone.
     intrinsic: bool,
+    /// The shape graph the parts were made on: the columns of the families chosen from the
+    /// data (the extrinsic family's in the collection frame appended when chosen) and their
+    /// weights.
+    graph: ShapeGraph,
 }
 
 impl CollectionParts {
@@ -310,6 +329,7 @@ impl CollectionParts {
                 segmentation: s.segmentation,
                 tree,
                 intrinsic,
+                graph: s.graph,
             });
         }
         Ok(self.data.as_ref().expect("made above"))
@@ -355,6 +375,38 @@ impl CollectionParts {
         let s = segment_collection_sharing(self.nodes.clone(), meshes, &o, smoothers, alignment)?;
         let intrinsic = self.read_intrinsic(&s);
         Ok((s.segmentation, intrinsic))
+    }
+
+    /// The shape graph over the feature families the collection chose from the data, when
+    /// they are not the per-shape pipeline's: `Some` when the pipeline holds the intrinsic
+    /// family alone and the bare co-segmentation ([`Self::data_parts`], made here if it was
+    /// not yet) chose the extrinsic family too, in the collection frame; `None` when the
+    /// pipeline's own graph reads the same families. The graph's nodes are the pipeline's
+    /// with the extrinsic columns appended, its feature weights the choice's (one share each
+    /// for the spectral columns, the heights and distances, and the normal columns).
+    ///
+    /// Errors: those of [`segment_collection`](crate::parts::segment_collection).
+    pub fn chosen_graph(
+        &mut self,
+        meshes: &[TriMesh],
+        smoothers: Option<&[HeatSmoother]>,
+    ) -> Result<Option<ShapeGraph>, GraphError> {
+        self.chosen_graph_sharing(meshes, smoothers, None)
+    }
+
+    /// [`Self::chosen_graph`] with the collection alignment of `meshes` made by the caller
+    /// ([`SharedAlignment`]; the rigid route's).
+    pub(crate) fn chosen_graph_sharing(
+        &mut self,
+        meshes: &[TriMesh],
+        smoothers: Option<&[HeatSmoother]>,
+        alignment: Option<SharedAlignment<'_>>,
+    ) -> Result<Option<ShapeGraph>, GraphError> {
+        if !self.intrinsic_pipeline {
+            return Ok(None);
+        }
+        let data = self.data(meshes, smoothers, alignment)?;
+        Ok((!data.intrinsic).then(|| data.graph.clone()))
     }
 
     /// Whether the co-segmentation for `count` labels, once made, read the intrinsic family
