@@ -6,39 +6,8 @@
 mod common;
 
 use common::cli::{FAST_PIPELINE, arg as s, coseg, text};
+use common::outputs::{output_files as files, same_files as same};
 use std::path::{Path, PathBuf};
-
-/// The files of `dir` (not its folders) by name, `summary.json` without its
-/// `collection_stage` field (the last one, written only by a re-cut).
-fn files(dir: &Path) -> Vec<(String, Vec<u8>)> {
-    let mut out: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.is_file())
-        .map(|p| {
-            let name = p.file_name().unwrap().to_string_lossy().into_owned();
-            let mut bytes = std::fs::read(&p).unwrap();
-            if name == "summary.json" {
-                let t = text(&bytes).replace(",\n  \"collection_stage\": \"recut\"\n}", "\n}");
-                bytes = t.into_bytes();
-            }
-            (name, bytes)
-        })
-        .collect();
-    out.sort();
-    out
-}
-
-fn same(a: &[(String, Vec<u8>)], b: &[(String, Vec<u8>)], what: &str) {
-    assert_eq!(
-        a.iter().map(|f| &f.0).collect::<Vec<_>>(),
-        b.iter().map(|f| &f.0).collect::<Vec<_>>(),
-        "{what}"
-    );
-    for ((name, x), (_, y)) in a.iter().zip(b) {
-        assert!(x == y, "{what}: {name} differs");
-    }
-}
 
 /// The shipped chairs.
 fn chairs() -> PathBuf {

@@ -5,21 +5,10 @@
 mod common;
 
 use coseg::propagate::{PropagateCollectionOptions, propagate_collection, propagate_loaded};
-use std::path::Path;
 
 /// The point-map entries of `cache`, sorted, with their bytes.
-fn maps(cache: &Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
-    let mut out: Vec<_> = std::fs::read_dir(cache)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|x| x == "coseg-map"))
-        .map(|p| {
-            let b = std::fs::read(&p).unwrap();
-            (p, b)
-        })
-        .collect();
-    out.sort();
-    out
+fn maps(cache: &std::path::Path) -> Vec<(std::path::PathBuf, Vec<u8>)> {
+    common::outputs::cache_entries(cache, "coseg-map")
 }
 
 #[test]

@@ -8,6 +8,7 @@ pub mod generate;
 pub mod graph;
 pub mod mesh;
 pub mod motion;
+pub mod outputs;
 pub mod shapes;
 pub mod stable;
 pub mod studio;
