@@ -5,6 +5,7 @@ mod common;
 
 use common::cli::{FAST_PIPELINE, arg as s, coseg, text};
 use common::features::{blob, similarity};
+use common::outputs::same_files as same;
 use coseg::mesh::write_mesh;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -683,16 +684,6 @@ fn warm_runs_write_the_cold_runs_files_byte_for_byte() {
         let r = coseg(&args);
         assert_eq!(r.status.code(), Some(0), "{}", text(&r.stderr));
         (files(&out), text(&r.stdout))
-    };
-    let same = |a: &[(String, Vec<u8>)], b: &[(String, Vec<u8>)], what: &str| {
-        assert_eq!(
-            a.iter().map(|f| &f.0).collect::<Vec<_>>(),
-            b.iter().map(|f| &f.0).collect::<Vec<_>>(),
-            "{what}"
-        );
-        for ((name, x), (_, y)) in a.iter().zip(b) {
-            assert!(x == y, "{what}: {name} differs");
-        }
     };
     let segment = ["segment", s(&input)];
     let (cold, cold_out) = run("1", &segment, "seg-cold", Some(&cache));
